@@ -1,0 +1,91 @@
+// Binning for the colored scatter (ARCHITECTURE "Parallel scatter without
+// races"). Cells are grouped into square tiles of T cells per direction;
+// a particle's key is its tile index times T^D plus its cell inside the
+// tile, so a stable counting sort by key groups particles tile by tile (and
+// cell by cell inside a tile, for locality). Tiles whose indices have the
+// same parity in every direction share a color; two tiles of one color are
+// at least T cells apart, and a particle in cell c touches nodes c-1 .. c+2
+// at most (every shape function here), so T >= 3 keeps same-colored tiles
+// on disjoint nodes.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "kernels/reduce.hpp"
+
+namespace mmpm {
+
+template <int D>
+struct TileLayout {
+  int T = 8;                        // tile edge in cells
+  std::array<int, 3> cells{1, 1, 1};
+  std::array<int, 3> tiles{1, 1, 1};
+  std::uint32_t keys_per_tile = 1;  // T^D
+  std::uint32_t tile_count = 1;
+
+  void setup(int tile_edge, const std::array<int, 3>& grid_cells) {
+    T = tile_edge;
+    cells = grid_cells;
+    keys_per_tile = 1;
+    tile_count = 1;
+    for (int d = 0; d < D; ++d) {
+      tiles[d] = (cells[d] + T - 1) / T;
+      keys_per_tile *= std::uint32_t(T);
+      tile_count *= std::uint32_t(tiles[d]);
+    }
+  }
+  std::uint32_t key_count() const { return tile_count * keys_per_tile; }
+
+  // Key of a cell given by its integer indices (clamped into the grid so that
+  // a particle exactly on the upper boundary still gets a valid key).
+  std::uint32_t key(const std::array<int, 3>& c_in) const {
+    std::uint32_t tile = 0, local = 0, tstride = 1, lstride = 1;
+    for (int d = 0; d < D; ++d) {
+      int c = c_in[d] < 0 ? 0 : (c_in[d] >= cells[d] ? cells[d] - 1 : c_in[d]);
+      tile += std::uint32_t(c / T) * tstride;
+      local += std::uint32_t(c % T) * lstride;
+      tstride *= std::uint32_t(tiles[d]);
+      lstride *= std::uint32_t(T);
+    }
+    return tile * keys_per_tile + local;
+  }
+  int color(std::uint32_t tile) const {
+    int col = 0;
+    for (int d = 0; d < D; ++d) {
+      col |= int(tile % std::uint32_t(tiles[d]) & 1u) << d;
+      tile /= std::uint32_t(tiles[d]);
+    }
+    return col;
+  }
+};
+
+// Cell index of a coordinate (cell units): floor, as an int.
+template <class Real>
+inline int cell_of(Real x, Real origin, Real inv_h) {
+  return int(std::floor((x - origin) * inv_h));
+}
+
+// Stable counting sort: fills perm so that perm[new] = old, and offsets
+// (size key_count + 1) with the first sorted position of every key.
+inline void counting_sort(const std::uint32_t* key, std::size_t n, std::uint32_t key_count,
+                          std::vector<std::uint32_t>& offsets, std::vector<std::uint32_t>& perm) {
+  offsets.assign(std::size_t(key_count) + 1, 0);
+  for (std::size_t p = 0; p < n; ++p) ++offsets[key[p] + 1];
+  for (std::size_t k = 0; k < key_count; ++k) offsets[k + 1] += offsets[k];
+  perm.resize(n);
+  std::vector<std::uint32_t> next(offsets.begin(), offsets.end() - 1);
+  for (std::size_t p = 0; p < n; ++p) perm[next[key[p]]++] = std::uint32_t(p);
+}
+
+// out[i] = in[perm[i]] for one array; parallel and race-free.
+template <class T>
+inline void gather_permute(const T* in, T* out, const std::uint32_t* perm, std::size_t n) {
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+  for (std::size_t i = 0; i < n; ++i) out[i] = in[perm[i]];
+}
+
+}  // namespace mmpm

@@ -1,0 +1,181 @@
+// Constitutive updates, one kernel per material type over that type's
+// particles (ARCHITECTURE "one constitutive kernel per type"). Small-strain
+// materials integrate sigma += C : d_eps with d_eps = dt sym(L); the
+// finite-strain neo-Hookean material updates F and evaluates sigma(F).
+// Volumes follow det(I + dt L) (small strain) or J V0 (finite strain).
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+
+#include "kernels/particle_view.hpp"
+#include "kernels/reduce.hpp"
+
+namespace mmpm {
+
+// Material constants prepared once by model/material.cpp.
+struct ElasticKernelConstants {
+  double lambda = 0, mu = 0;  // isotropic / neo-Hookean (plane strain & 3D)
+  double Ep = 0, nu = 0;      // plane stress isotropic: E/(1-nu^2), nu
+  double density = 1;
+  bool plane_stress = false;
+  // General small-strain stiffness in the global frame. 2D: rows
+  // (d_sxx, d_syy, d_sxy, d_szz) from columns (d_exx, d_eyy, d_gxy) — plane
+  // strain or plane stress reduced; zz_strain gives d_ezz (plane stress).
+  // 3D: 6x6 Voigt (xx, yy, zz, yz, xz, xy) with engineering shear strains.
+  double C2[4][3] = {};
+  double zz_strain[3] = {};
+  double C3[6][6] = {};
+};
+
+// Loops over the particles of one material: idx[k] (or k when idx is null).
+template <class Body>
+inline void for_particles(const std::uint32_t* idx, std::size_t count, Body&& body) {
+  if (idx) {
+#pragma omp parallel for schedule(static) if (count >= kParallelMin)
+    for (std::size_t k = 0; k < count; ++k) body(std::size_t(idx[k]));
+  } else {
+#pragma omp parallel for schedule(static) if (count >= kParallelMin)
+    for (std::size_t k = 0; k < count; ++k) body(k);
+  }
+}
+
+template <int D, class Real>
+inline Real volume_ratio(const ParticleView<D, Real>& P, std::size_t p, Real dt) {
+  if constexpr (D == 2) {
+    const Real a = Real(1) + dt * P.L[0][p], b = dt * P.L[1][p];
+    const Real c = dt * P.L[2][p], d = Real(1) + dt * P.L[3][p];
+    return a * d - b * c;
+  } else {
+    Real A[9];
+    for (int i = 0; i < 9; ++i) A[i] = dt * P.L[i][p] + ((i % 4) == 0 ? Real(1) : Real(0));
+    return A[0] * (A[4] * A[8] - A[5] * A[7]) - A[1] * (A[3] * A[8] - A[5] * A[6]) +
+           A[2] * (A[3] * A[7] - A[4] * A[6]);
+  }
+}
+
+template <int D, class Real>
+void isotropic_update(const ParticleView<D, Real>& P, const std::uint32_t* idx, std::size_t count,
+                      const ElasticKernelConstants& c, double dt_in) {
+  const Real dt = Real(dt_in), lam = Real(c.lambda), mu2 = Real(2 * c.mu);
+  const Real Ep = Real(c.Ep), nu = Real(c.nu);
+  const bool pstress = c.plane_stress;
+  for_particles(idx, count, [&](std::size_t p) {
+    if constexpr (D == 2) {
+      const Real exx = dt * P.L[0][p], eyy = dt * P.L[3][p];
+      const Real exy = Real(0.5) * dt * (P.L[1][p] + P.L[2][p]);
+      Real J = volume_ratio(P, p, dt);
+      if (pstress) {
+        P.s[0][p] += Ep * (exx + nu * eyy);
+        P.s[1][p] += Ep * (eyy + nu * exx);
+        P.s[2][p] += mu2 * exy;
+        J *= Real(1) - nu / (Real(1) - nu) * (exx + eyy);
+      } else {
+        const Real tr = lam * (exx + eyy);
+        P.s[0][p] += tr + mu2 * exx;
+        P.s[1][p] += tr + mu2 * eyy;
+        P.s[2][p] += mu2 * exy;
+        P.s[3][p] += tr;
+      }
+      P.V[p] *= J;
+    } else {
+      const Real e0 = dt * P.L[0][p], e1 = dt * P.L[4][p], e2 = dt * P.L[8][p];
+      const Real tr = lam * (e0 + e1 + e2);
+      P.s[0][p] += tr + mu2 * e0;
+      P.s[1][p] += tr + mu2 * e1;
+      P.s[2][p] += tr + mu2 * e2;
+      P.s[3][p] += Real(0.5) * mu2 * dt * (P.L[5][p] + P.L[7][p]);  // yz
+      P.s[4][p] += Real(0.5) * mu2 * dt * (P.L[2][p] + P.L[6][p]);  // xz
+      P.s[5][p] += Real(0.5) * mu2 * dt * (P.L[1][p] + P.L[3][p]);  // xy
+      P.V[p] *= volume_ratio(P, p, dt);
+    }
+  });
+}
+
+template <int D, class Real>
+void anisotropic_update(const ParticleView<D, Real>& P, const std::uint32_t* idx,
+                        std::size_t count, const ElasticKernelConstants& c, double dt_in) {
+  const Real dt = Real(dt_in);
+  Real C2[4][3], Z[3], C3[6][6];
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 3; ++j) C2[i][j] = Real(c.C2[i][j]);
+  for (int j = 0; j < 3; ++j) Z[j] = Real(c.zz_strain[j]);
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j) C3[i][j] = Real(c.C3[i][j]);
+  const bool pstress = c.plane_stress;
+  for_particles(idx, count, [&](std::size_t p) {
+    if constexpr (D == 2) {
+      const Real e[3] = {dt * P.L[0][p], dt * P.L[3][p], dt * (P.L[1][p] + P.L[2][p])};
+      for (int i = 0; i < 4; ++i) P.s[i][p] += C2[i][0] * e[0] + C2[i][1] * e[1] + C2[i][2] * e[2];
+      Real J = volume_ratio(P, p, dt);
+      if (pstress) J *= Real(1) + Z[0] * e[0] + Z[1] * e[1] + Z[2] * e[2];
+      P.V[p] *= J;
+    } else {
+      const Real e[6] = {dt * P.L[0][p], dt * P.L[4][p], dt * P.L[8][p],
+                         dt * (P.L[5][p] + P.L[7][p]), dt * (P.L[2][p] + P.L[6][p]),
+                         dt * (P.L[1][p] + P.L[3][p])};
+      for (int i = 0; i < 6; ++i) {
+        Real ds = 0;
+        for (int j = 0; j < 6; ++j) ds += C3[i][j] * e[j];
+        P.s[i][p] += ds;
+      }
+      P.V[p] *= volume_ratio(P, p, dt);
+    }
+  });
+}
+
+// Compressible neo-Hookean: sigma = mu/J (B - I) + lambda ln(J)/J I,
+// F <- (I + dt L) F. Plane strain in 2D (F_zz = 1).
+template <int D, class Real>
+void neohookean_update(const ParticleView<D, Real>& P, const std::uint32_t* idx,
+                       std::size_t count, const ElasticKernelConstants& c, double dt_in) {
+  const Real dt = Real(dt_in), lam = Real(c.lambda), mu = Real(c.mu);
+  const Real inv_rho = Real(1 / c.density);
+  for_particles(idx, count, [&](std::size_t p) {
+    Real A[D * D], F[D * D], Fn[D * D];
+    for (int i = 0; i < D * D; ++i) {
+      A[i] = dt * P.L[i][p] + ((i % (D + 1)) == 0 ? Real(1) : Real(0));
+      F[i] = P.F[i][p];
+    }
+    for (int i = 0; i < D; ++i)
+      for (int j = 0; j < D; ++j) {
+        Real s = 0;
+        for (int k = 0; k < D; ++k) s += A[i * D + k] * F[k * D + j];
+        Fn[i * D + j] = s;
+      }
+    for (int i = 0; i < D * D; ++i) P.F[i][p] = Fn[i];
+    Real J;
+    if constexpr (D == 2)
+      J = Fn[0] * Fn[3] - Fn[1] * Fn[2];
+    else
+      J = Fn[0] * (Fn[4] * Fn[8] - Fn[5] * Fn[7]) - Fn[1] * (Fn[3] * Fn[8] - Fn[5] * Fn[6]) +
+          Fn[2] * (Fn[3] * Fn[7] - Fn[4] * Fn[6]);
+    // J <= 0 is caught by the stepper's finiteness check through log(J) = NaN.
+    const Real lnJ = std::log(J), inv_J = Real(1) / J;
+    Real B[D * D];
+    for (int i = 0; i < D; ++i)
+      for (int j = 0; j < D; ++j) {
+        Real s = 0;
+        for (int k = 0; k < D; ++k) s += Fn[i * D + k] * Fn[j * D + k];
+        B[i * D + j] = s;
+      }
+    const Real pr = lam * lnJ * inv_J;
+    if constexpr (D == 2) {
+      P.s[0][p] = mu * inv_J * (B[0] - Real(1)) + pr;
+      P.s[1][p] = mu * inv_J * (B[3] - Real(1)) + pr;
+      P.s[2][p] = mu * inv_J * B[1];
+      P.s[3][p] = pr;
+    } else {
+      P.s[0][p] = mu * inv_J * (B[0] - Real(1)) + pr;
+      P.s[1][p] = mu * inv_J * (B[4] - Real(1)) + pr;
+      P.s[2][p] = mu * inv_J * (B[8] - Real(1)) + pr;
+      P.s[3][p] = mu * inv_J * B[5];
+      P.s[4][p] = mu * inv_J * B[2];
+      P.s[5][p] = mu * inv_J * B[1];
+    }
+    P.V[p] = P.m[p] * inv_rho * J;
+  });
+}
+
+}  // namespace mmpm

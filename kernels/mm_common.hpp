@@ -1,0 +1,119 @@
+// Multimaterial pass: parameter and result types shared by its pieces, and the
+// few small-vector helpers the pass needs. See docs/multimaterial.md and
+// ALGORITHM §3-§7. Header-only, no allocation, no I/O.
+#pragma once
+
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "scene/scene.hpp"  // enums Law, NormalMethod, Separation, Integration, TractionLaw
+
+namespace mmpm {
+
+template <int D, class Real>
+using VecD = std::array<Real, D>;
+
+// Properties of one interacting material pair (one [[interaction]] of the scene).
+template <class Real>
+struct PairParams {
+  static constexpr Real kPerfect = std::numeric_limits<Real>::infinity();
+
+  Law law = Law::stick;  // Law::separate behaves like a -1 entry of the pair table
+  Real friction = 0;     // Coulomb mu (Law::friction), (P-16)
+  Real Dn = 0;           // interface stiffness, normal (tension for bilinear); kPerfect = perfect
+  Real Dt = 0;           // interface stiffness, tangential; kPerfect = perfect
+  TractionLaw traction_law = TractionLaw::linear;
+  Real Dn_compression = kPerfect;  // bilinear: normal stiffness used when delta_n < 0
+  NormalMethod normal_method = NormalMethod::mvg;
+  std::array<Real, 3> normal_vector{1, 0, 0};  // specified normal, from `first_field` to the other
+  std::array<Real, 3> radial_center{0, 0, 0};  // radial normal n ∝ x_i − c, from `first_field` out
+  // Field the specified / radial normal points away from (the scene's materials[0]).
+  // When the pass treats the other field as `a`, those normals are negated (n runs a → b).
+  int first_field = -1;
+  Separation separation = Separation::displacement;
+  Real omega_min = 0;  // ABSOLUTE nodal domain below which the node is skipped (units of grid.vol)
+  bool force_limit = true;  // §4.4 (explicit integration only)
+  Integration integration = Integration::explicit_;
+};
+
+// Everything the two passes need besides the grid.
+template <int D, class Real>
+struct MMConfig {
+  int fields = 0;                             // F: material velocity fields
+  const int* pair = nullptr;                  // F*F table: [a*F+b] = index into params, -1 = separate
+  const PairParams<Real>* params = nullptr;
+  const unsigned char* rigid = nullptr;       // F flags; null = no rigid field
+  Real dt = 0;                                // time step
+  // 2D only: multiplies the area (P-20). Use the thickness t when grid.vol holds areas
+  // (Σ S_ip A_p, as in P-19); use 1 when grid.vol already holds A_p·t.
+  Real thickness = 1;
+  Real mass_threshold = 0;                    // a field with m <= threshold is empty at the node
+  // Include Δf_i of (P-27) from grid.f in the force limit and in the exact integration.
+  // Off by default (ALGORITHM §2: neglected in pass A).
+  bool use_force_difference = false;
+};
+
+// Per-step diagnostics. Both passes ADD to it; reset() before pass A of a step.
+struct MMStats {
+  double interface_energy = 0;  // Σ U_i (ALGORITHM §3.2), counted per §6
+  long nodes_2 = 0;             // nodes with exactly two materials (pass A)
+  long nodes_3plus = 0;         // nodes with three or more materials (pass A)
+  long force_limited = 0;       // node-directions converted to stick (§4.4 / §4.5) in pass A
+  // Reaction force on each rigid field: −Σ(momentum changes/dt + interface forces) applied
+  // to the non-rigid materials it touches (zero for non-rigid fields). Size F.
+  std::vector<std::array<double, 3>> rigid_reaction;
+
+  void reset(int fields) {
+    interface_energy = 0;
+    nodes_2 = nodes_3plus = force_limited = 0;
+    rigid_reaction.assign(std::size_t(fields), std::array<double, 3>{0, 0, 0});
+  }
+};
+
+// stick_flags bits (one byte per (node of the list, field a)): interface directions that
+// pass A turned into stick (perfect or limited), which pass B re-applies.
+inline constexpr unsigned char kStickNormal = 1;
+inline constexpr unsigned char kStickTangential = 2;
+inline constexpr unsigned char kStickBoth = 4;
+
+// Fields handled at one node (gathered into fixed-size local arrays).
+inline constexpr int kMaxFields = 32;
+
+namespace mm_detail {
+
+template <int D, class Real>
+inline Real dot(const VecD<D, Real>& u, const VecD<D, Real>& v) {
+  Real s = 0;
+  for (int d = 0; d < D; ++d) s += u[d] * v[d];
+  return s;
+}
+
+template <int D, class Real>
+inline VecD<D, Real> scaled(const VecD<D, Real>& u, Real s) {
+  VecD<D, Real> r;
+  for (int d = 0; d < D; ++d) r[d] = u[d] * s;
+  return r;
+}
+
+// u + s v
+template <int D, class Real>
+inline VecD<D, Real> add_scaled(const VecD<D, Real>& u, const VecD<D, Real>& v, Real s) {
+  VecD<D, Real> r;
+  for (int d = 0; d < D; ++d) r[d] = u[d] + s * v[d];
+  return r;
+}
+
+// Unit vector along u, or all zeros when |u| is zero or not finite.
+template <int D, class Real>
+inline VecD<D, Real> normalized_or_zero(const VecD<D, Real>& u) {
+  const Real len = std::sqrt(dot<D, Real>(u, u));
+  if (!(len > 0) || !std::isfinite(len)) return VecD<D, Real>{};
+  return scaled<D, Real>(u, Real(1) / len);
+}
+
+}  // namespace mm_detail
+}  // namespace mmpm

@@ -1,0 +1,206 @@
+// Imperfect interfaces at a multimaterial node (ALGORITHM §3.2, §4): traction laws,
+// the effective cell thickness h⊥ (P-21, P-22), the contact area (P-20), the force
+// limit for stiff interfaces (P-23 … P-27) and the exact integration of the
+// interface spring (§4.5). Derivations: docs/multimaterial.md.
+#pragma once
+
+#include "kernels/mm_common.hpp"
+
+namespace mmpm {
+
+// ---------------------------------------------------------------- traction laws
+// A traction law maps the openings (δ_n, δ_t ≥ 0) to tractions, the stiffness in use
+// (for the exact integration) and the energy density per direction. A direction whose
+// stiffness is +inf is "perfect": no traction, no energy, always stick (§3.2).
+template <class Real>
+struct Traction {
+  Real normal = 0, tangential = 0;        // T_n, T_t (force per area)
+  Real stiffness_n = 0, stiffness_t = 0;  // D in use this step
+  Real energy_n = 0, energy_t = 0;        // energy per area: ∫T d[u] per direction
+  bool perfect_n = false, perfect_t = false;
+};
+
+namespace mm_detail {
+// One linear direction T = D δ, energy ½ D δ²; D = +inf → perfect.
+template <class Real>
+inline void linear_direction(Real stiffness, Real opening, Real& traction, Real& stiffness_out,
+                             Real& energy, bool& perfect) {
+  stiffness_out = stiffness;
+  perfect = std::isinf(stiffness);
+  traction = perfect ? Real(0) : stiffness * opening;
+  energy = perfect ? Real(0) : Real(0.5) * stiffness * opening * opening;
+}
+}  // namespace mm_detail
+
+// Linear law (P-3, P-4): T_n = D_n δ_n, T_t = D_t δ_t, φ = ½(D_n δ_n² + D_t δ_t²).
+template <class Real>
+Traction<Real> traction_linear(Real Dn, Real Dt, Real delta_n, Real delta_t) {
+  Traction<Real> r;
+  mm_detail::linear_direction(Dn, delta_n, r.normal, r.stiffness_n, r.energy_n, r.perfect_n);
+  mm_detail::linear_direction(Dt, delta_t, r.tangential, r.stiffness_t, r.energy_t, r.perfect_t);
+  return r;
+}
+
+// Bilinear in δ_n (paper §3 end, ALGORITHM §3.2): D_n in tension (δ_n ≥ 0), D_n^c in
+// compression (δ_n < 0); energy ½ D δ_n² with the branch's D (elastic, kink at 0).
+template <class Real>
+Traction<Real> traction_bilinear(Real Dn_tension, Real Dn_compression, Real Dt, Real delta_n,
+                                 Real delta_t) {
+  return traction_linear(delta_n < 0 ? Dn_compression : Dn_tension, Dt, delta_n, delta_t);
+}
+
+template <class Real>
+Traction<Real> evaluate_traction(const PairParams<Real>& pp, Real delta_n, Real delta_t) {
+  switch (pp.traction_law) {
+    case TractionLaw::bilinear:
+      return traction_bilinear(pp.Dn, pp.Dn_compression, pp.Dt, delta_n, delta_t);
+    case TractionLaw::linear:
+    default:
+      return traction_linear(pp.Dn, pp.Dt, delta_n, delta_t);
+  }
+}
+
+// ---------------------------------------------------------------- h⊥ and area
+// h⊥ (P-21, P-22 method 1): V_cell / (h1 h2) with h1, h2 the distances from the node to
+// the ellipsoid Σ x_k²/Δx_k² = 1 along t and n × t. Equals Δx on a regular mesh.
+template <class Real>
+Real h_perp_2d(const VecD<2, Real>& n, const std::array<Real, 3>& h) {
+  return std::sqrt(n[0] * n[0] * h[0] * h[0] + n[1] * n[1] * h[1] * h[1]);
+}
+
+template <class Real>
+Real h_perp_3d(const VecD<3, Real>& n, const VecD<3, Real>& t, const std::array<Real, 3>& h) {
+  const VecD<3, Real> s{n[1] * t[2] - n[2] * t[1], n[2] * t[0] - n[0] * t[2],
+                        n[0] * t[1] - n[1] * t[0]};
+  Real sum_t = 0, sum_s = 0;
+  for (int k = 0; k < 3; ++k) {
+    const Real inv_h2 = Real(1) / (h[k] * h[k]);
+    sum_t += t[k] * t[k] * inv_h2;
+    sum_s += s[k] * s[k] * inv_h2;
+  }
+  return h[0] * h[1] * h[2] * std::sqrt(sum_t * sum_s);
+}
+
+// D-generic entry: t is ignored in 2D.
+template <int D, class Real>
+Real h_perp(const VecD<D, Real>& n, const VecD<D, Real>& t, const std::array<Real, 3>& h) {
+  if constexpr (D == 2) {
+    (void)t;
+    return h_perp_2d<Real>(n, h);
+  } else {
+    return h_perp_3d<Real>(n, t, h);
+  }
+}
+
+// Contact area (P-20): A_i = t sqrt(2 Ω_i min(Ω_a, Ω_b)) / h⊥ in 2D (t = `thickness`),
+// without t in 3D. Ω_i = Ω_a + Ω_b.
+template <int D, class Real>
+Real contact_area(Real vol_a, Real vol_b, Real h_perp_value, Real thickness) {
+  const Real total = vol_a + vol_b;
+  const Real smaller = vol_a < vol_b ? vol_a : vol_b;
+  const Real area = std::sqrt(Real(2) * total * smaller) / h_perp_value;
+  if constexpr (D == 2) return thickness * area;
+  return area;
+}
+
+// ---------------------------------------------------------------- force limit
+// Component along a direction of the largest meaningful interface force on a (P-26):
+// the force that brings a and b to the center-of-mass displacement in one step under
+// the midpoint rule (P-23 … P-25):
+//   f_lim = (2 m_red / Δt²)(u_b − u_a) + (2/Δt) Δp_a + Δf_i,  m_red = m_a m_b/(m_a + m_b)
+// `separation` = (u_b − u_a)·d, `momentum_change` = Δp_a·d, `force_difference` = Δf_i·d.
+template <class Real>
+Real force_limit_component(Real m_red, Real dt, Real separation, Real momentum_change,
+                           Real force_difference = 0) {
+  return Real(2) * m_red / (dt * dt) * separation + Real(2) / dt * momentum_change +
+         force_difference;
+}
+
+// The direction becomes stick when the interface force exceeds the limit in magnitude.
+template <class Real>
+inline bool exceeds_force_limit(Real force, Real limit) {
+  return std::abs(force) > std::abs(limit);
+}
+
+// Reduced mass of the pair; a rigid b has infinite mass, so m_red = m_a (P-28 … P-31).
+template <class Real>
+inline Real reduced_mass(Real m_a, Real m_b, bool b_is_rigid) {
+  return b_is_rigid ? m_a : m_a * m_b / (m_a + m_b);
+}
+
+// Δf_i of (P-27) = (m_a f_b − m_b f_a)/(m_a + m_b) = m_red (f_b/m_b − f_a/m_a); for a
+// rigid b (prescribed velocity, no acceleration within the step) it is −f_a.
+template <int D, class Real>
+VecD<D, Real> force_difference(Real m_a, const VecD<D, Real>& f_a, Real m_b,
+                               const VecD<D, Real>& f_b, bool b_is_rigid) {
+  VecD<D, Real> r;
+  if (b_is_rigid) {
+    for (int d = 0; d < D; ++d) r[d] = -f_a[d];
+  } else {
+    const Real inv = Real(1) / (m_a + m_b);
+    for (int d = 0; d < D; ++d) r[d] = (m_a * f_b[d] - m_b * f_a[d]) * inv;
+  }
+  return r;
+}
+
+// ---------------------------------------------------------------- exact integration
+// §4.5: along one direction the relative coordinate s = u_b − u_a obeys
+//   m_red s'' = −k s + Δf,  k = D A_i,  ω² = k / m_red,
+// solved exactly over Δt from s(0) = s0, s'(0) = w0 = Δp_a·d / m_red:
+//   s(Δt) = s* + (s0 − s*) cos θ + (w0/ω) sin θ,  s* = Δf/k,  θ = ωΔt.
+// The force applied is the one that, under the same midpoint rule as the force limit
+// (P-23 … P-25), lands the pair exactly on s(Δt):
+//   F = (2 m_red/Δt²)(s0 + w0 Δt − s(Δt)) + Δf
+//     = k s0 C(θ) + (2/Δt) Δp_a·d S(θ) + Δf (1 − C(θ)),
+//   C(θ) = 2(1 − cos θ)/θ² = (sin(θ/2)/(θ/2))²,  S(θ) = 1 − sin θ / θ.
+// C → 1, S → 0 as θ → 0 (the explicit force k s0); with s(Δt) = 0 it is f_lim. When
+// θ > 1.5 the direction is effectively perfect and becomes stick.
+inline constexpr double kExactStickOmegaDt = 1.5;
+
+template <class Real>
+struct SpringStep {
+  Real force = 0;      // interface force on a along the direction
+  bool stick = false;  // θ > kExactStickOmegaDt: treat the direction as stick
+  Real omega_dt = 0;   // θ
+};
+
+namespace mm_detail {
+// C(θ) = 2(1 − cos θ)/θ², without cancellation.
+template <class Real>
+inline Real oscillator_cos_term(Real theta) {
+  const Real half = Real(0.5) * theta;
+  if (half < Real(1e-4)) return Real(1) - theta * theta / Real(12);
+  const Real sinc = std::sin(half) / half;
+  return sinc * sinc;
+}
+// S(θ) = 1 − sin θ/θ; a series below 0.5 avoids the cancellation (truncation < 1e-12 rel).
+template <class Real>
+inline Real oscillator_sin_term(Real theta) {
+  if (theta < Real(0.5)) {
+    const Real x2 = theta * theta;
+    return x2 / Real(6) *
+           (Real(1) - x2 / Real(20) *
+                          (Real(1) - x2 / Real(42) *
+                                         (Real(1) - x2 / Real(72) * (Real(1) - x2 / Real(110)))));
+  }
+  return Real(1) - std::sin(theta) / theta;
+}
+}  // namespace mm_detail
+
+template <class Real>
+SpringStep<Real> exact_spring_force(Real stiffness, Real m_red, Real dt, Real separation,
+                                    Real momentum_change, Real force_difference = 0) {
+  SpringStep<Real> r;
+  r.omega_dt = dt * std::sqrt(stiffness / m_red);
+  if (r.omega_dt > Real(kExactStickOmegaDt)) {
+    r.stick = true;
+    return r;
+  }
+  const Real c = mm_detail::oscillator_cos_term(r.omega_dt);
+  const Real s = mm_detail::oscillator_sin_term(r.omega_dt);
+  r.force = stiffness * separation * c + Real(2) / dt * momentum_change * s +
+            force_difference * (Real(1) - c);
+  return r;
+}
+
+}  // namespace mmpm

@@ -1,0 +1,551 @@
+// The multimaterial pass (ALGORITHM §2 steps 3 and 5, §3 … §7) over the compact
+// list of multimaterial nodes. Pieces: mm_common.hpp (types), mm_normals.hpp (§5),
+// mm_contact.hpp (§3.1), mm_interface.hpp (§3.2, §4). Derivations and the exact
+// contract of each pass: docs/multimaterial.md.
+//
+//   find_multimaterial_nodes  nodes where ≥ 2 fields have m > threshold, ascending
+//   multimaterial_pass_a      after P2G: contact momentum changes, interface forces
+//                             into grid.fi, energy, force limit → stick_flags
+//   multimaterial_pass_b      after the grid momentum update: contact on the new
+//                             momenta, stick re-applied where stick_flags say so
+//
+// Every node of the list is independent (it writes only its own grid entries), so the
+// node loop runs in parallel; statistics are summed per fixed chunk of the list and the
+// chunks are added in order, so results do not depend on the number of threads.
+#pragma once
+
+#include <algorithm>
+#include <cassert>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "kernels/grid_view.hpp"
+#include "kernels/mm_common.hpp"
+#include "kernels/mm_contact.hpp"
+#include "kernels/mm_interface.hpp"
+#include "kernels/mm_normals.hpp"
+
+namespace mmpm {
+
+// One material at a node, or the lump of several ("virtual b", §3, §6).
+template <int D, class Real>
+struct MaterialSide {
+  Real m = 0, vol = 0;
+  VecD<D, Real> p{}, mx{}, g{}, f{};
+};
+
+// What an interaction does to material a (b gets the negatives when deformable).
+template <int D, class Real>
+struct InteractionResult {
+  VecD<D, Real> momentum_change{};  // added to p_a
+  VecD<D, Real> force{};            // added to fi_a (interface force, P-17)
+  double energy = 0;                // interface energy U_i (§3.2)
+  unsigned char stick = 0;          // kStick* bits of interface directions made stick
+  int limited = 0;                  // directions converted to stick by §4.4 / §4.5
+  bool evaluated = false;           // false: screened (§3 Ω_min) or no normal
+};
+
+// Geometry and kinematics of a pair at a node (§3, P-7 … P-15).
+template <int D, class Real>
+struct PairGeometry {
+  VecD<D, Real> n{};      // unit normal a → b
+  VecD<D, Real> dp{};     // Δp_a (P-7), rigid b: (P-29)
+  VecD<D, Real> t{};      // unit tangent along the tangential opening (P-15)
+  Real delta_n = 0;       // δ·n (P-12)
+  Real delta_t = 0;       // |δ − δ_n n| ≥ 0 (P-15)
+  Real h_perp = 0;        // (P-22)
+  bool valid = false;
+};
+
+// Checks a configuration once, outside the hot loops. nullptr when usable.
+template <int D, class Real>
+const char* validate_multimaterial(const GridView<D, Real>& grid, const MMConfig<D, Real>& cfg) {
+  const int F = cfg.fields;
+  if (F != grid.fields) return "MMConfig.fields differs from GridView.fields";
+  if (F < 2 || F > kMaxFields) return "multimaterial pass needs 2 <= fields <= kMaxFields";
+  if (!cfg.pair) return "MMConfig.pair is required";
+  if (!(cfg.dt > 0)) return "MMConfig.dt must be positive";
+  if (!grid.m || !grid.vol) return "grid m and vol are required";
+  for (int d = 0; d < D; ++d)
+    if (!grid.p[d] || !grid.mx[d]) return "grid p and mx are required";
+  for (int a = 0; a < F; ++a) {
+    for (int b = 0; b < F; ++b) {
+      const int k = cfg.pair[a * F + b];
+      if (k != cfg.pair[b * F + a]) return "MMConfig.pair must be symmetric";
+      if (k < 0 || a == b) continue;
+      if (!cfg.params) return "MMConfig.params is required by the pair table";
+      const PairParams<Real>& pp = cfg.params[k];
+      const bool gradient = pp.normal_method == NormalMethod::mvg ||
+                            pp.normal_method == NormalMethod::avg ||
+                            pp.normal_method == NormalMethod::rigid;
+      for (int d = 0; d < D; ++d) {
+        if (gradient && !grid.g[d]) return "grid g is required by the mvg/avg/rigid normals";
+        if (pp.law == Law::interface && !grid.fi[d]) return "grid fi is required by interfaces";
+        if (cfg.use_force_difference && !grid.f[d]) return "grid f is required by Δf";
+      }
+    }
+  }
+  return nullptr;
+}
+
+// Nodes where at least two fields have m > mass_threshold, in ascending order.
+template <int D, class Real>
+void find_multimaterial_nodes(const GridView<D, Real>& grid, Real mass_threshold,
+                              std::vector<std::uint32_t>& list) {
+  const std::size_t nodes = grid.nodes;
+  const int F = grid.fields;
+  if (F < 2 || !grid.m || nodes == 0) {
+    list.clear();
+    return;
+  }
+  constexpr std::size_t kBlock = 4096;
+  const std::size_t blocks = (nodes + kBlock - 1) / kBlock;
+  std::vector<std::size_t> offset(blocks + 1, 0);
+  const Real* m = grid.m;
+
+#pragma omp parallel for schedule(static)
+  for (std::size_t b = 0; b < blocks; ++b) {
+    const std::size_t end = std::min(nodes, (b + 1) * kBlock);
+    std::size_t count = 0;
+#pragma omp simd reduction(+ : count)
+    for (std::size_t i = b * kBlock; i < end; ++i) {
+      int present = 0;
+      for (int f = 0; f < F; ++f) present += m[std::size_t(f) * nodes + i] > mass_threshold;
+      count += present >= 2;
+    }
+    offset[b + 1] = count;
+  }
+  for (std::size_t b = 0; b < blocks; ++b) offset[b + 1] += offset[b];
+  list.resize(offset[blocks]);
+
+#pragma omp parallel for schedule(static)
+  for (std::size_t b = 0; b < blocks; ++b) {
+    const std::size_t end = std::min(nodes, (b + 1) * kBlock);
+    std::size_t out = offset[b];
+    for (std::size_t i = b * kBlock; i < end; ++i) {
+      int present = 0;
+      for (int f = 0; f < F; ++f) present += m[std::size_t(f) * nodes + i] > mass_threshold;
+      if (present >= 2) list[out++] = std::uint32_t(i);
+    }
+  }
+}
+
+namespace mm_detail {
+
+// Normal by the pair's method (§5). `sign` orients specified/radial normals a → b.
+template <int D, class Real>
+VecD<D, Real> interface_normal(const PairParams<Real>& pp, const MaterialSide<D, Real>& a,
+                               const MaterialSide<D, Real>& b, bool b_is_rigid, Real sign,
+                               const std::array<Real, 3>& node_position) {
+  switch (pp.normal_method) {
+    case NormalMethod::avg:
+      return normal_avg<D, Real>(a.vol, a.g, b.vol, b.g);
+    case NormalMethod::specified:
+      return normal_specified<D, Real>(pp.normal_vector, sign);
+    case NormalMethod::radial:
+      return normal_radial<D, Real>(node_position, pp.radial_center, sign);
+    case NormalMethod::rigid:  // RMVG; without a rigid partner it falls back to MVG
+      if (b_is_rigid) return normal_rigid<D, Real>(b.g);
+      return normal_mvg<D, Real>(a.g, b.g);
+    case NormalMethod::mvg:
+    default:
+      return normal_mvg<D, Real>(a.g, b.g);
+  }
+}
+
+template <int D, class Real>
+PairGeometry<D, Real> pair_geometry(const MaterialSide<D, Real>& a, const MaterialSide<D, Real>& b,
+                                    bool b_is_rigid, const PairParams<Real>& pp, Real sign,
+                                    const std::array<Real, 3>& node_position,
+                                    const std::array<Real, 3>& h) {
+  PairGeometry<D, Real> G;
+  G.n = interface_normal<D, Real>(pp, a, b, b_is_rigid, sign, node_position);
+  if (dot<D, Real>(G.n, G.n) == Real(0)) return G;  // no direction: skip the node
+  G.dp = momentum_change_to_center_of_mass<D, Real>(a.m, a.p, b.m, b.p, b_is_rigid);
+  // δ = x_b − x_a with x_j = mx_j / m_j (P-11; rigid b: P-31).
+  VecD<D, Real> delta;
+  const Real inv_ma = Real(1) / a.m, inv_mb = Real(1) / b.m;
+  for (int d = 0; d < D; ++d) delta[d] = b.mx[d] * inv_mb - a.mx[d] * inv_ma;
+  G.delta_n = dot<D, Real>(delta, G.n);
+  const VecD<D, Real> opening_t = add_scaled<D, Real>(delta, G.n, -G.delta_n);  // (P-15)
+  G.delta_t = std::sqrt(dot<D, Real>(opening_t, opening_t));
+  G.t = tangent_or_perpendicular<D, Real>(opening_t, G.delta_t, G.n);
+  G.h_perp = mmpm::h_perp<D, Real>(G.n, G.t, h);
+  G.valid = true;
+  return G;
+}
+
+// One interface direction (§3.2, §4.4, §4.5).
+template <class Real>
+struct DirectionOutcome {
+  Real force = 0;
+  Real energy = 0;
+  bool stick = false;
+  bool limited = false;
+};
+
+template <class Real>
+DirectionOutcome<Real> interface_direction(const PairParams<Real>& pp, bool perfect,
+                                           Real stiffness, Real traction, Real energy_density,
+                                           Real area, Real m_red, Real dt, Real separation,
+                                           Real momentum_change, Real force_diff) {
+  DirectionOutcome<Real> o;
+  if (perfect) {  // always stick, zero energy, no force limit computation
+    o.stick = true;
+    return o;
+  }
+  if (pp.integration == Integration::exact) {
+    const SpringStep<Real> s =
+        exact_spring_force(stiffness * area, m_red, dt, separation, momentum_change, force_diff);
+    if (s.stick) {
+      o.stick = o.limited = true;
+      return o;
+    }
+    o.force = s.force;
+    o.energy = energy_density * area;
+    return o;
+  }
+  const Real force = traction * area;
+  if (pp.force_limit &&
+      exceeds_force_limit(force, force_limit_component(m_red, dt, separation, momentum_change,
+                                                       force_diff))) {
+    o.stick = o.limited = true;
+    return o;
+  }
+  o.force = force;
+  o.energy = energy_density * area;
+  return o;
+}
+
+// Volume screening (§3) then the pair geometry; G.valid is false when the pair is skipped.
+template <int D, class Real>
+PairGeometry<D, Real> screened_geometry(const MaterialSide<D, Real>& a,
+                                        const MaterialSide<D, Real>& b, bool b_is_rigid,
+                                        const PairParams<Real>& pp, Real sign,
+                                        const std::array<Real, 3>& node_position,
+                                        const std::array<Real, 3>& h) {
+  if (a.vol + b.vol < pp.omega_min) return PairGeometry<D, Real>{};
+  return pair_geometry<D, Real>(a, b, b_is_rigid, pp, sign, node_position, h);
+}
+
+template <int D, class Real>
+InteractionResult<D, Real> contact_result(const PairGeometry<D, Real>& G,
+                                          const PairParams<Real>& pp, Real corrected_dn) {
+  InteractionResult<D, Real> r;
+  r.evaluated = true;
+  if (in_contact(dot<D, Real>(G.dp, G.n), corrected_dn))
+    r.momentum_change = contact_momentum_change<D, Real>(pp.law, pp.friction, G.dp, G.n);
+  return r;
+}
+
+// Everything pass A does for material a against (virtual) b.
+template <int D, class Real>
+InteractionResult<D, Real> interact_pass_a(const MaterialSide<D, Real>& a,
+                                           const MaterialSide<D, Real>& b, bool b_is_rigid,
+                                           const PairParams<Real>& pp, Real sign,
+                                           const std::array<Real, 3>& node_position,
+                                           const std::array<Real, 3>& h, Real dt,
+                                           Real thickness, bool use_force_difference) {
+  InteractionResult<D, Real> r;
+  const PairGeometry<D, Real> G =
+      screened_geometry<D, Real>(a, b, b_is_rigid, pp, sign, node_position, h);
+  if (!G.valid) return r;
+  const Real dn = corrected_normal_separation(pp.separation, G.delta_n, G.h_perp);
+  if (pp.law != Law::interface) return contact_result<D, Real>(G, pp, dn);
+
+  r.evaluated = true;
+  const Traction<Real> tr = evaluate_traction(pp, dn, G.delta_t);
+  const Real area = contact_area<D, Real>(a.vol, b.vol, G.h_perp, thickness);
+  const Real m_red = reduced_mass(a.m, b.m, b_is_rigid);
+  VecD<D, Real> df{};
+  if (use_force_difference) df = force_difference<D, Real>(a.m, a.f, b.m, b.f, b_is_rigid);
+
+  const DirectionOutcome<Real> on =
+      interface_direction(pp, tr.perfect_n, tr.stiffness_n, tr.normal, tr.energy_n, area, m_red,
+                          dt, dn, dot<D, Real>(G.dp, G.n), dot<D, Real>(df, G.n));
+  const DirectionOutcome<Real> ot =
+      interface_direction(pp, tr.perfect_t, tr.stiffness_t, tr.tangential, tr.energy_t, area,
+                          m_red, dt, G.delta_t, dot<D, Real>(G.dp, G.t), dot<D, Real>(df, G.t));
+  r.stick = (on.stick ? kStickNormal : 0) | (ot.stick ? kStickTangential : 0);
+  if (on.stick && ot.stick) r.stick |= kStickBoth;
+  r.limited = int(on.limited) + int(ot.limited);
+  r.momentum_change = directional_stick_change<D, Real>(r.stick, G.dp, G.n);
+  for (int d = 0; d < D; ++d) r.force[d] = on.force * G.n[d] + ot.force * G.t[d];
+  r.energy = double(on.energy) + double(ot.energy);
+  return r;
+}
+
+// Pass B for material a against (virtual) b: contact on the updated momenta, or stick
+// re-applied along the interface directions flagged in pass A.
+template <int D, class Real>
+InteractionResult<D, Real> interact_pass_b(const MaterialSide<D, Real>& a,
+                                           const MaterialSide<D, Real>& b, bool b_is_rigid,
+                                           const PairParams<Real>& pp, Real sign,
+                                           const std::array<Real, 3>& node_position,
+                                           const std::array<Real, 3>& h,
+                                           unsigned char stick_flags) {
+  InteractionResult<D, Real> r;
+  if (pp.law == Law::interface && stick_flags == 0) return r;
+  const PairGeometry<D, Real> G =
+      screened_geometry<D, Real>(a, b, b_is_rigid, pp, sign, node_position, h);
+  if (!G.valid) return r;
+  if (pp.law != Law::interface)
+    return contact_result<D, Real>(
+        G, pp, corrected_normal_separation(pp.separation, G.delta_n, G.h_perp));
+  r.evaluated = true;
+  r.momentum_change = directional_stick_change<D, Real>(stick_flags, G.dp, G.n);
+  return r;
+}
+
+// The fields present at a node, gathered into contiguous local arrays.
+template <int D, class Real>
+struct NodeFields {
+  int count = 0;
+  int field[kMaxFields];
+  MaterialSide<D, Real> side[kMaxFields];
+};
+
+// What the pairs of a configuration read besides m, p, mx, vol.
+struct PassNeeds {
+  bool gradient = false;  // some pair uses the mvg / avg / rigid normal
+  bool position = false;  // some pair uses the radial normal
+  bool force = false;     // Δf_i (pass A with cfg.use_force_difference)
+};
+
+template <int D, class Real>
+PassNeeds pass_needs(const MMConfig<D, Real>& cfg, bool pass_a) {
+  PassNeeds needs;
+  needs.force = pass_a && cfg.use_force_difference;
+  const int F = cfg.fields;
+  for (int k = 0; k < F * F; ++k) {
+    if (cfg.pair[k] < 0) continue;
+    const NormalMethod method = cfg.params[cfg.pair[k]].normal_method;
+    needs.position |= method == NormalMethod::radial;
+    needs.gradient |= method == NormalMethod::mvg || method == NormalMethod::avg ||
+                      method == NormalMethod::rigid;
+  }
+  return needs;
+}
+
+template <int D, class Real>
+void gather_node(const GridView<D, Real>& grid, std::size_t node, Real mass_threshold,
+                 const PassNeeds& needs, NodeFields<D, Real>& out) {
+  out.count = 0;
+  for (int j = 0; j < grid.fields; ++j) {
+    const std::size_t at = grid.at(j, node);
+    const Real m = grid.m[at];
+    if (!(m > mass_threshold)) continue;
+    MaterialSide<D, Real>& s = out.side[out.count];
+    out.field[out.count++] = j;
+    s.m = m;
+    s.vol = grid.vol[at];
+    for (int d = 0; d < D; ++d) {
+      s.p[d] = grid.p[d][at];
+      s.mx[d] = grid.mx[d][at];
+      s.g[d] = needs.gradient ? grid.g[d][at] : Real(0);
+      s.f[d] = needs.force ? grid.f[d][at] : Real(0);
+    }
+  }
+}
+
+template <int D, class Real>
+inline void add_in_place(MaterialSide<D, Real>& lump, const MaterialSide<D, Real>& s) {
+  lump.m += s.m;
+  lump.vol += s.vol;
+  for (int d = 0; d < D; ++d) {
+    lump.p[d] += s.p[d];
+    lump.mx[d] += s.mx[d];
+    lump.g[d] += s.g[d];
+    lump.f[d] += s.f[d];
+  }
+}
+
+// Statistics of one chunk of the node list.
+struct ChunkStats {
+  double energy = 0;
+  long nodes_2 = 0, nodes_3plus = 0, limited = 0;
+  double* reaction = nullptr;  // F × 3
+};
+
+template <int D, class Real>
+inline void add_reaction(ChunkStats& cs, int rigid_field, const VecD<D, Real>& momentum_change,
+                         const VecD<D, Real>& force, Real inv_dt) {
+  for (int d = 0; d < D; ++d)
+    cs.reaction[3 * rigid_field + d] -=
+        double(momentum_change[d]) * double(inv_dt) + double(force[d]);
+}
+
+// One node of the list, pass A (kPassA) or pass B.
+template <int D, class Real, bool kPassA>
+void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::size_t k,
+                  std::size_t node, const PassNeeds& needs, NodeFields<D, Real>& nf,
+                  const unsigned char* flags_in, unsigned char* flags_out, ChunkStats& cs) {
+  const int F = cfg.fields;
+  gather_node<D, Real>(grid, node, cfg.mass_threshold, needs, nf);
+  const int K = nf.count;
+  if (K < 2) return;
+  if constexpr (kPassA) (K == 2 ? cs.nodes_2 : cs.nodes_3plus) += 1;
+
+  const std::array<Real, 3> x_node =
+      needs.position ? grid.position(node) : std::array<Real, 3>{0, 0, 0};
+  const Real inv_dt = Real(1) / cfg.dt;
+  auto is_rigid = [&](int field) { return cfg.rigid != nullptr && cfg.rigid[field] != 0; };
+  auto params_of = [&](int fa, int fb) -> const PairParams<Real>* {
+    const int idx = cfg.pair[fa * F + fb];
+    if (idx < 0 || cfg.params[idx].law == Law::separate) return nullptr;
+    return &cfg.params[idx];
+  };
+  auto interact = [&](const MaterialSide<D, Real>& a, const MaterialSide<D, Real>& b,
+                      bool b_rigid, const PairParams<Real>& pp, int field_a) {
+    const Real sign = field_a == pp.first_field ? Real(1) : Real(-1);
+    if constexpr (kPassA) {
+      return interact_pass_a<D, Real>(a, b, b_rigid, pp, sign, x_node, grid.h, cfg.dt,
+                                      cfg.thickness, cfg.use_force_difference);
+    } else {
+      return interact_pass_b<D, Real>(a, b, b_rigid, pp, sign, x_node, grid.h,
+                                      flags_in[k * std::size_t(F) + std::size_t(field_a)]);
+    }
+  };
+  auto apply = [&](int field, const VecD<D, Real>& dp, const VecD<D, Real>& force, Real s) {
+    const std::size_t at = grid.at(field, node);
+    for (int d = 0; d < D; ++d) grid.p[d][at] += s * dp[d];
+    if constexpr (kPassA) {
+      if (grid.fi[0])
+        for (int d = 0; d < D; ++d) grid.fi[d][at] += s * force[d];
+    }
+  };
+
+  if (K == 2) {  // §6: compute once for a, apply the negatives to b
+    int ia = 0, ib = 1;
+    const PairParams<Real>* pp = params_of(nf.field[0], nf.field[1]);
+    if (!pp) return;
+    const bool rigid0 = is_rigid(nf.field[0]), rigid1 = is_rigid(nf.field[1]);
+    if (rigid0 && rigid1) return;
+    if (rigid0) std::swap(ia, ib);  // a is always the deformable one (§7)
+    const int fa = nf.field[ia], fb = nf.field[ib];
+    const bool b_rigid = rigid0 || rigid1;
+    const InteractionResult<D, Real> r = interact(nf.side[ia], nf.side[ib], b_rigid, *pp, fa);
+    apply(fa, r.momentum_change, r.force, Real(1));
+    if (b_rigid)
+      add_reaction<D, Real>(cs, fb, r.momentum_change, r.force, inv_dt);
+    else
+      apply(fb, r.momentum_change, r.force, Real(-1));
+    if constexpr (kPassA) {
+      cs.energy += r.energy;
+      cs.limited += r.limited;
+      flags_out[k * std::size_t(F) + std::size_t(fa)] = r.stick;
+    }
+    return;
+  }
+
+  // §6, three or more materials: each deformable a against the lump of its partners
+  // (or against its rigid partner), all computed from the gathered snapshot, applied after.
+  VecD<D, Real> change[kMaxFields], force[kMaxFields];
+  bool lumped_energy_counted = false;
+  for (int ia = 0; ia < K; ++ia) {
+    change[ia] = VecD<D, Real>{};
+    force[ia] = VecD<D, Real>{};
+    const int fa = nf.field[ia];
+    if (is_rigid(fa)) continue;
+    MaterialSide<D, Real> lump;
+    int largest_rigid = -1, largest_other = -1;
+    for (int ib = 0; ib < K; ++ib) {
+      if (ib == ia || !params_of(fa, nf.field[ib])) continue;
+      if (is_rigid(nf.field[ib])) {
+        if (largest_rigid < 0 || nf.side[ib].vol > nf.side[largest_rigid].vol) largest_rigid = ib;
+      } else {
+        add_in_place<D, Real>(lump, nf.side[ib]);
+        if (largest_other < 0 || nf.side[ib].vol > nf.side[largest_other].vol) largest_other = ib;
+      }
+    }
+    const bool b_rigid = largest_rigid >= 0;
+    const int partner = b_rigid ? largest_rigid : largest_other;
+    if (partner < 0) continue;
+    const PairParams<Real>& pp = *params_of(fa, nf.field[partner]);
+    const InteractionResult<D, Real> r =
+        interact(nf.side[ia], b_rigid ? nf.side[partner] : lump, b_rigid, pp, fa);
+    change[ia] = r.momentum_change;
+    force[ia] = r.force;
+    if (b_rigid) add_reaction<D, Real>(cs, nf.field[partner], r.momentum_change, r.force, inv_dt);
+    if constexpr (kPassA) {
+      // Energy once per node among lumped interactions, once per rigid interaction (§6).
+      if (b_rigid) {
+        cs.energy += r.energy;
+      } else if (pp.law == Law::interface && r.evaluated && !lumped_energy_counted) {
+        cs.energy += r.energy;
+        lumped_energy_counted = true;
+      }
+      cs.limited += r.limited;
+      flags_out[k * std::size_t(F) + std::size_t(fa)] = r.stick;
+    }
+  }
+  for (int ia = 0; ia < K; ++ia) apply(nf.field[ia], change[ia], force[ia], Real(1));
+}
+
+template <int D, class Real, bool kPassA>
+void run_pass(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
+              const MMConfig<D, Real>& cfg, MMStats& stats, const unsigned char* flags_in,
+              unsigned char* flags_out) {
+  assert(validate_multimaterial(grid, cfg) == nullptr);
+  const int F = cfg.fields;
+  if (stats.rigid_reaction.size() != std::size_t(F))
+    stats.rigid_reaction.resize(std::size_t(F), std::array<double, 3>{0, 0, 0});
+  const std::size_t n = list.size();
+  if (n == 0) return;
+  const PassNeeds needs = pass_needs(cfg, kPassA);
+
+  constexpr std::size_t kChunk = 64;  // fixed: the reduction order never depends on threads
+  const std::size_t chunks = (n + kChunk - 1) / kChunk;
+  const std::size_t reaction_stride = 3 * std::size_t(F);
+  std::vector<ChunkStats> partial(chunks);
+  std::vector<double> reactions(chunks * reaction_stride, 0.0);
+  for (std::size_t c = 0; c < chunks; ++c) partial[c].reaction = &reactions[c * reaction_stride];
+
+#pragma omp parallel
+  {
+    NodeFields<D, Real> nf;
+#pragma omp for schedule(dynamic, 1)
+    for (std::size_t c = 0; c < chunks; ++c) {
+      const std::size_t end = std::min(n, (c + 1) * kChunk);
+      for (std::size_t k = c * kChunk; k < end; ++k)
+        process_node<D, Real, kPassA>(grid, cfg, k, list[k], needs, nf, flags_in, flags_out,
+                                      partial[c]);
+    }
+  }
+
+  for (std::size_t c = 0; c < chunks; ++c) {  // serial, in chunk order
+    stats.interface_energy += partial[c].energy;
+    stats.nodes_2 += partial[c].nodes_2;
+    stats.nodes_3plus += partial[c].nodes_3plus;
+    stats.force_limited += partial[c].limited;
+    for (int j = 0; j < F; ++j)
+      for (int d = 0; d < 3; ++d) stats.rigid_reaction[j][d] += partial[c].reaction[3 * j + d];
+  }
+}
+
+}  // namespace mm_detail
+
+// Pass A (ALGORITHM §2 step 3), after P2G filled m, p, mx, vol, g (and f if
+// cfg.use_force_difference). The caller zeroes grid.fi beforehand. stick_flags is resized
+// to list.size() * F and written: entry [k*F + a] holds the kStick* bits of the
+// interaction computed for field a at node list[k].
+template <int D, class Real>
+void multimaterial_pass_a(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
+                          const MMConfig<D, Real>& cfg, MMStats& stats,
+                          std::vector<unsigned char>& stick_flags) {
+  stick_flags.assign(list.size() * std::size_t(cfg.fields), 0);
+  mm_detail::run_pass<D, Real, true>(grid, list, cfg, stats, nullptr, stick_flags.data());
+}
+
+// Pass B (ALGORITHM §2 step 5), after the grid momentum update, with the same list, the
+// same m, mx, vol, g and the stick_flags of pass A. No interface force, no energy.
+template <int D, class Real>
+void multimaterial_pass_b(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
+                          const MMConfig<D, Real>& cfg,
+                          const std::vector<unsigned char>& stick_flags, MMStats& stats) {
+  assert(stick_flags.size() == list.size() * std::size_t(cfg.fields));
+  mm_detail::run_pass<D, Real, false>(grid, list, cfg, stats, stick_flags.data(), nullptr);
+}
+
+}  // namespace mmpm

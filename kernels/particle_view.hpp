@@ -1,0 +1,33 @@
+// Raw views of the particle arrays (SoA). Owned by model/particles.hpp.
+// Stress components: 2D xx, yy, xy, zz; 3D xx, yy, zz, yz, xz, xy (Voigt).
+// A pointer is null when the scene does not need that array.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+namespace mmpm {
+
+template <int D>
+inline constexpr int kStressComponents = D == 2 ? 4 : 6;
+
+template <int D, class Real>
+struct ParticleView {
+  std::size_t n = 0;
+  std::array<Real*, D> x{};       // position
+  std::array<Real*, D> v{};       // velocity
+  Real* m = nullptr;              // mass
+  Real* V = nullptr;              // current volume (area * thickness in 2D)
+  std::array<Real*, kStressComponents<D>> s{};  // Cauchy stress
+  std::array<Real*, D * D> L{};   // velocity gradient from G2P, row-major dv_a/dx_b
+  std::array<Real*, D * D> F{};   // deformation gradient (finite-strain materials only)
+  std::array<Real*, D> x0{};      // initial position (displacement output / separation)
+  std::array<Real*, D> lp{};      // uGIMP half-width in cell units (gimp only)
+  std::array<Real*, D> fext{};    // external (traction) force (only with traction loads)
+  std::uint8_t* field = nullptr;  // material velocity field (only with > 1 field)
+  std::uint8_t* mat = nullptr;    // material index
+  std::uint32_t* key = nullptr;   // binning key (tile-major cell index) at the last sort
+};
+
+}  // namespace mmpm

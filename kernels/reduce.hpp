@@ -1,0 +1,37 @@
+// Deterministic parallel sums: the index range is cut into fixed chunks
+// (independent of the thread count), each chunk is summed in order, then the
+// chunk sums are added serially. 1 and 2 threads give bitwise-equal results.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cstddef>
+#include <vector>
+
+namespace mmpm {
+
+inline constexpr std::size_t kReduceChunk = 4096;
+// Loops shorter than this run on one thread: waking a team costs more than
+// the work (a few microseconds per parallel region).
+inline constexpr std::size_t kParallelMin = 8192;
+
+inline std::size_t chunk_count(std::size_t n) { return (n + kReduceChunk - 1) / kReduceChunk; }
+
+// body(begin, end, acc) adds K values into acc for indices [begin, end).
+template <int K, class Body>
+std::array<double, K> deterministic_sum(std::size_t n, Body&& body) {
+  const std::size_t chunks = chunk_count(n);
+  std::vector<std::array<double, K>> partial(chunks);
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+  for (std::size_t c = 0; c < chunks; ++c) {
+    std::array<double, K> acc{};
+    body(c * kReduceChunk, std::min(n, (c + 1) * kReduceChunk), acc);
+    partial[c] = acc;
+  }
+  std::array<double, K> total{};
+  for (const auto& a : partial)
+    for (int k = 0; k < K; ++k) total[k] += a[k];
+  return total;
+}
+
+}  // namespace mmpm

@@ -1,0 +1,119 @@
+// mmpm command line: run, check, sweep, info (SCENE.md "Command line").
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <iostream>
+
+#include "app/build_info.hpp"
+#include "app/run_driver.hpp"
+#include "app/sweep.hpp"
+#include "scene/error.hpp"
+#include "scene/format.hpp"
+#include "scene/parse.hpp"
+#include "solver/simulation.hpp"
+
+namespace {
+
+int check_scene(const std::string& file, const std::vector<std::string>& sets) {
+  using namespace mmpm;
+  Scene scene = parse_scene_file(file, sets);
+  auto sim = make_simulation(scene);  // builds particles: catches geometry errors
+  std::cout << format_scene(scene);
+  const double crit = critical_time_step(scene), dt = sim->dt();
+  std::cout << "# instantiation: " << sim->instantiation() << "\n"
+            << "# particles: " << sim->particle_count() << ", nodes: " << sim->node_count()
+            << ", material fields: " << sim->field_count() << ", tile: " << sim->tile_edge() << " cells\n"
+            << "# dt: " << dt << " (stability limit " << crit << ", cfl " << dt / crit << "), steps: "
+            << long(std::ceil(scene.simulation.end_time / dt - 1e-9)) << "\n";
+  if (dt > crit * (1 + 1e-12))
+    std::cerr << file << ": warning: key 'simulation." << (scene.simulation.dt ? "dt" : "cfl")
+              << "': the time step exceeds the stability limit; `mmpm run` refuses it unless --force\n";
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"mmpm: multimaterial material point method with contact and imperfect interfaces"};
+  app.require_subcommand(1);
+
+  auto* run = app.add_subcommand("run", "run a scene");
+  std::string scene_file, restart_dir, out_dir;
+  std::vector<std::string> sets;
+  int threads = 0;
+  bool quiet = false, force = false;
+  run->add_option("scene", scene_file, "scene file (TOML)");
+  run->add_option("--restart", restart_dir, "continue the run in DIR from its last checkpoint");
+  run->add_option("--out", out_dir, "output directory (default results/<scene name>)");
+  run->add_option("--threads", threads, "OpenMP threads")->check(CLI::PositiveNumber);
+  run->add_option("--set", sets, "override a scene key: KEY=VALUE (TOML value)");
+  run->add_flag("--quiet", quiet, "no progress line, no timing table");
+  run->add_flag("--force", force, "run even when the time step exceeds the stability limit");
+
+  auto* check = app.add_subcommand("check", "validate a scene and print it resolved");
+  std::string check_file;
+  std::vector<std::string> check_sets;
+  check->add_option("scene", check_file, "scene file (TOML)")->required();
+  check->add_option("--set", check_sets, "override a scene key: KEY=VALUE");
+
+  auto* sweep = app.add_subcommand("sweep", "run a scene over a list of values of one key");
+  mmpm::SweepOptions so;
+  std::string values;
+  sweep->add_option("scene", so.scene_file, "scene file (TOML)")->required();
+  sweep->add_option("--param", so.param, "key to vary, as for --set")->required();
+  sweep->add_option("--values", values, "comma-separated TOML values")->required();
+  sweep->add_option("--jobs", so.jobs, "runs at once")->check(CLI::PositiveNumber);
+  sweep->add_option("--threads", so.threads, "OpenMP threads per run (default cores / jobs)");
+  sweep->add_option("--out", so.out, "output directory");
+  sweep->add_option("--set", so.overrides, "override a scene key for every run");
+  bool sweep_quiet = false;
+  sweep->add_flag("--quiet", sweep_quiet, "no per-run lines");
+
+  auto* info = app.add_subcommand("info", "build options, SIMD width, threads, library versions");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  }
+
+  try {
+    if (*info) {
+      std::cout << mmpm::build_description();
+      return 0;
+    }
+    if (*check) return check_scene(check_file, check_sets);
+    if (*sweep) {
+      so.values = mmpm::split_values(values);
+      so.quiet = sweep_quiet;
+      return mmpm::run_sweep(so);
+    }
+    mmpm::RunOptions ro;
+    ro.out = out_dir;
+    ro.threads = threads;
+    ro.quiet = quiet;
+    ro.force = force;
+    mmpm::RunOutcome r;
+    if (!restart_dir.empty()) {
+      r = mmpm::restart_run(restart_dir, ro, std::cout);
+    } else {
+      if (scene_file.empty()) {
+        std::cerr << "mmpm run: a scene file or --restart DIR is required\n";
+        return 2;
+      }
+      r = mmpm::run_scene(mmpm::parse_scene_file(scene_file, sets), ro, std::cout);
+    }
+    if (r.exit_code != 0) {
+      std::cerr << "mmpm: " << r.message << "\n";
+      return r.exit_code;
+    }
+    if (!quiet) std::cout << "results in " << r.directory.string() << "\n";
+    return 0;
+  } catch (const mmpm::InputError& e) {
+    std::cerr << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "mmpm: error: " << e.what() << "\n";
+    return 3;
+  }
+}

@@ -1,0 +1,323 @@
+#include "app/run_driver.hpp"
+
+#include <omp.h>
+#include <unistd.h>
+
+#include <cctype>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <ostream>
+#include <sstream>
+
+#include "app/build_info.hpp"
+#include "app/timing_table.hpp"
+#include "io/atomic_file.hpp"
+#include "io/checkpoint.hpp"
+#include "io/run_writer.hpp"
+#include "io/summary.hpp"
+#include "scene/error.hpp"
+#include "scene/parse.hpp"
+#include "solver/simulation.hpp"
+
+namespace mmpm {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+const char* kAxes[3] = {"x", "y", "z"};
+
+// State of the driver that a checkpoint must carry besides the simulation's.
+struct DriverState {
+  std::vector<std::string> names;
+  std::vector<std::vector<double>> columns;
+  long next_snapshot = 0;  // index k of the next snapshot time k * every
+  long streak_start = -1;  // first step of the current run of low kinetic ratio
+  long last_snapshot_step = -1;
+};
+
+// Series names allow letters, digits, '_', '.', '-' (run.h5 dataset names).
+std::string sanitize(std::string s) {
+  for (char& c : s)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.' || c == '-')) c = '_';
+  return s;
+}
+
+std::vector<std::string> series_names(const Simulation& sim) {
+  std::vector<std::string> n = {"time",     "step",          "kinetic", "strain", "interface",
+                                "external_work", "damping",  "kinetic_unresolved", "energy_balance"};
+  const int dim = sim.snapshot({}).dimension;
+  for (const auto& r : sim.reactions())
+    for (int d = 0; d < dim; ++d) n.push_back(sanitize("reaction_" + r.name + "_" + kAxes[d]));
+  for (const char* c : {"multimaterial_nodes", "nodes_3plus", "force_limited_nodes"}) n.push_back(c);
+  for (const char* s : kStageNames) n.push_back(std::string("stage_") + s + "_s");
+  return n;
+}
+
+void add_series_row(Simulation& sim, DriverState& st, const std::array<double, kStageCount>& stage_s,
+                    int dim) {
+  const Energies e = sim.energies();
+  // energy_balance: energy now (incl. what damping removed) minus the
+  // initial energy and the external work; zero for an exact integrator.
+  const double total = e.kinetic + e.strain + e.interface + e.damping;
+  const double initial = st.columns.empty() ? total - e.external_work
+                                            : st.columns[2][0] + st.columns[3][0] + st.columns[4][0];
+  std::vector<double> row = {sim.time(), double(sim.step_count()), e.kinetic, e.strain, e.interface,
+                             e.external_work, e.damping, e.kinetic_unresolved,
+                             total - e.external_work - initial};
+  for (const auto& r : sim.reactions())
+    for (int d = 0; d < dim; ++d) row.push_back(r.force[d]);
+  const StepCounters c = sim.counters();
+  row.push_back(double(c.multimaterial_nodes));
+  row.push_back(double(c.nodes_3plus));
+  row.push_back(double(c.force_limited_nodes));
+  for (double s : stage_s) row.push_back(s);
+  if (st.columns.empty()) st.columns.resize(row.size());
+  for (std::size_t k = 0; k < row.size(); ++k) st.columns[k].push_back(row[k]);
+}
+
+std::vector<io::Blob> driver_blobs(const DriverState& st) {
+  std::vector<io::Blob> b;
+  b.push_back(io::make_scalar_blob("driver.next_snapshot", st.next_snapshot));
+  b.push_back(io::make_scalar_blob("driver.streak_start", st.streak_start));
+  b.push_back(io::make_scalar_blob("driver.last_snapshot_step", st.last_snapshot_step));
+  for (std::size_t k = 0; k < st.columns.size(); ++k)
+    b.push_back(io::make_blob("driver.series." + std::to_string(k), st.columns[k]));
+  return b;
+}
+
+void load_driver_blobs(const std::vector<io::Blob>& blobs, DriverState& st) {
+  st.next_snapshot = io::read_scalar_blob<long>(io::find_blob(blobs, "driver.next_snapshot"));
+  st.streak_start = io::read_scalar_blob<long>(io::find_blob(blobs, "driver.streak_start"));
+  st.last_snapshot_step = io::read_scalar_blob<long>(io::find_blob(blobs, "driver.last_snapshot_step"));
+  st.columns.assign(st.names.size(), {});
+  for (std::size_t k = 0; k < st.names.size(); ++k)
+    io::read_blob(io::find_blob(blobs, "driver.series." + std::to_string(k)), st.columns[k]);
+}
+
+class Progress {
+ public:
+  Progress(bool on, double end_time) : on_(on), end_(end_time), start_(Clock::now()), last_(start_) {}
+  void update(long step, double t, bool force = false) {
+    if (!on_) return;
+    const auto now = Clock::now();
+    if (!force && std::chrono::duration<double>(now - last_).count() < 0.25) return;
+    last_ = now;
+    const double el = std::chrono::duration<double>(now - start_).count();
+    const double rate = el > 0 ? double(step - first_step_) / el : 0.0;
+    const double frac = end_ > 0 ? t / end_ : 0.0;
+    const double eta = frac > 0 && frac < 1 && el > 0 ? el * (1 - frac) / std::max(1e-12, frac - first_frac_) : 0.0;
+    std::fprintf(stderr, "\rstep %9ld  t = %.6g / %.6g  %9.0f steps/s  ETA %7.1f s   ", step, t, end_, rate, eta);
+    std::fflush(stderr);
+  }
+  void start_at(long step, double t) {
+    first_step_ = step;
+    first_frac_ = end_ > 0 ? t / end_ : 0.0;
+  }
+  void done() {
+    if (on_) std::fprintf(stderr, "\n");
+  }
+
+ private:
+  bool on_;
+  double end_;
+  Clock::time_point start_, last_;
+  long first_step_ = 0;
+  double first_frac_ = 0;
+};
+
+RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, const fs::path& dir,
+                 const std::vector<io::Blob>* resume) {
+  RunOutcome out;
+  out.directory = dir;
+  const auto wall0 = Clock::now();
+  if (opt.threads > 0) omp_set_num_threads(opt.threads);
+  const int threads = opt.threads > 0 ? opt.threads : omp_get_max_threads();
+
+  const double crit = critical_time_step(scene);
+  const double dt = stable_time_step(scene);
+  if (dt > crit * (1 + 1e-12) && !(opt.force || scene.simulation.force)) {
+    std::ostringstream m;
+    m << scene.source_file << ": key 'simulation." << (scene.simulation.dt ? "dt" : "cfl")
+      << "': time step " << dt << " exceeds the stability limit " << crit
+      << " (cfl " << dt / crit << " > 1); lower it, or run with --force";
+    throw InputError(m.str());
+  }
+  std::unique_ptr<Simulation> sim = make_simulation(scene);
+  const int dim = scene.simulation.dimension;
+  DriverState st;
+  st.names = series_names(*sim);
+
+  fs::create_directories(dir);
+  std::unique_ptr<io::RunWriter> writer;
+  if (resume) {
+    sim->load_state(*resume);
+    load_driver_blobs(*resume, st);
+    writer = std::make_unique<io::RunWriter>(io::RunWriter::reopen(dir, st.last_snapshot_step));
+  } else {
+    fs::remove(dir / "summary.json");
+    fs::remove(dir / "checkpoint.bin");
+    io::write_file_atomic(dir / "scene.toml", scene.source_text);
+    writer = std::make_unique<io::RunWriter>(dir);
+  }
+  writer->set_attribute("scene", scene.source_text);
+  writer->set_attribute("build", build_description());
+  writer->set_attribute("instantiation", sim->instantiation());
+
+  const auto& o = scene.output;
+  const double end_time = scene.simulation.end_time;
+  const double every = o.every;
+  const bool tty = opt.progress && !opt.quiet && isatty(STDERR_FILENO);
+  Progress progress(tty, end_time);
+  progress.start_at(sim->step_count(), sim->time());
+  std::array<double, kStageCount> stage_s{};  // output stage is timed here
+  auto sim_stages = [&] {
+    auto s = sim->stage_seconds();
+    s[kStageOutput] = stage_s[kStageOutput];
+    return s;
+  };
+  long output_calls = 0;
+  auto snapshot_if_due = [&](bool final) {
+    const double t = sim->time();
+    const bool due = every > 0 && t >= double(st.next_snapshot) * every - 0.5 * sim->dt();
+    if (!(due || (final && st.last_snapshot_step != sim->step_count()))) return;
+    const auto t0 = Clock::now();
+    writer->write_snapshot(sim->snapshot(o.fields));
+    st.last_snapshot_step = sim->step_count();
+    if (every > 0)
+      while (double(st.next_snapshot) * every - 0.5 * sim->dt() <= t) ++st.next_snapshot;
+    stage_s[kStageOutput] += std::chrono::duration<double>(Clock::now() - t0).count();
+    ++output_calls;
+  };
+  auto checkpoint = [&] {
+    const auto t0 = Clock::now();
+    std::vector<io::Blob> blobs = sim->save_state();
+    for (auto& b : driver_blobs(st)) blobs.push_back(std::move(b));
+    io::write_checkpoint(dir / "checkpoint.bin", blobs);
+    stage_s[kStageOutput] += std::chrono::duration<double>(Clock::now() - t0).count();
+  };
+
+  if (!resume) {
+    add_series_row(*sim, st, sim_stages(), dim);
+    snapshot_if_due(false);
+  }
+  std::string stopped_by = "end_time";
+  const long series_every = std::max(1, o.series);
+  const long stop_check = scene.stop.enabled ? std::max(1L, std::min<long>(series_every, scene.stop.hold_steps / 4)) : 0;
+  const double ckpt_s = o.checkpoint_minutes * 60.0;
+  auto last_ckpt = Clock::now();
+  try {
+    while (sim->time() < end_time - 1e-9 * sim->dt()) {
+      sim->step();
+      const long s = sim->step_count();
+      bool stop = false;
+      if (stop_check > 0 && s % stop_check == 0) {
+        const Energies e = sim->energies();
+        const double stored = e.strain + e.interface;
+        const double ratio = stored > 0 ? e.kinetic / stored : INFINITY;
+        if (ratio < scene.stop.kinetic_ratio) {
+          if (st.streak_start < 0) st.streak_start = s;
+          if (s - st.streak_start >= scene.stop.hold_steps) stop = true;
+        } else {
+          st.streak_start = -1;
+        }
+      }
+      if (s % series_every == 0 || stop) add_series_row(*sim, st, sim_stages(), dim);
+      snapshot_if_due(false);
+      if (stop) {
+        stopped_by = "kinetic_ratio";
+        break;
+      }
+      if (ckpt_s > 0 && std::chrono::duration<double>(Clock::now() - last_ckpt).count() >= ckpt_s) {
+        checkpoint();
+        last_ckpt = Clock::now();
+      }
+      progress.update(s, sim->time());
+    }
+  } catch (const SimulationError& e) {
+    progress.done();
+    writer->abandon();
+    out.exit_code = 3;
+    out.message = e.what();
+    return out;
+  }
+  progress.update(sim->step_count(), sim->time(), true);
+  progress.done();
+  if (st.columns.empty() || st.columns[1].back() != double(sim->step_count()))
+    add_series_row(*sim, st, sim_stages(), dim);
+  snapshot_if_due(true);
+  writer->write_series(st.names, st.columns);
+  writer->finish();
+  fs::remove(dir / "checkpoint.bin");
+
+  const double wall = std::chrono::duration<double>(Clock::now() - wall0).count();
+  auto stages = sim_stages();
+  auto calls = sim->stage_calls();
+  calls[kStageOutput] = output_calls;
+  const Energies e = sim->energies();
+  const StepCounters c = sim->counters();
+  nlohmann::json j;
+  j["scene"] = scene.name;
+  j["dimension"] = dim;
+  j["precision"] = scene.simulation.precision == Precision::float64 ? "double" : "float";
+  j["particles"] = sim->particle_count();
+  j["nodes"] = sim->node_count();
+  j["materials"] = scene.materials.size();
+  j["steps"] = sim->step_count();
+  j["end_time"] = sim->time();
+  j["dt"] = sim->dt();
+  j["threads"] = threads;
+  j["wall_s"] = wall;
+  const double ps = double(sim->particle_count()) * double(std::max(1L, sim->step_count()));
+  j["ns_per_particle_step"] = wall * 1e9 / ps;
+  nlohmann::json js;
+  double timed = 0;
+  for (int k = 0; k < kStageCount; ++k) {
+    js[kStageNames[k]] = stages[k];
+    timed += stages[k];
+  }
+  js["other"] = wall - timed;
+  j["stages_s"] = js;
+  j["energy"] = {{"kinetic", e.kinetic}, {"strain", e.strain}, {"interface", e.interface},
+                 {"external_work", e.external_work}, {"damping", e.damping}};
+  j["multimaterial_nodes"] = c.multimaterial_nodes;
+  j["nodes_3plus"] = c.nodes_3plus;
+  j["force_limited_nodes"] = c.force_limited_nodes;
+  j["stopped_by"] = stopped_by;
+  io::write_summary(dir / "summary.json", j);
+  out.summary = j;
+  if (opt.timing_table && !opt.quiet)
+    print_timing_table(log, stages, calls, wall, sim->step_count(), sim->particle_count());
+  return out;
+}
+
+fs::path output_dir(const Scene& scene, const RunOptions& opt) {
+  if (!opt.out.empty()) return opt.out;
+  if (!scene.output.directory.empty()) return scene.output.directory;
+  return fs::path("results") / scene.name;
+}
+
+}  // namespace
+
+RunOutcome run_scene(const Scene& scene, const RunOptions& options, std::ostream& log) {
+  return drive(scene, options, log, output_dir(scene, options), nullptr);
+}
+
+RunOutcome restart_run(const fs::path& dir, const RunOptions& options, std::ostream& log) {
+  const fs::path scene_file = dir / "scene.toml";
+  if (!fs::exists(scene_file)) throw InputError(scene_file.string() + ": no resolved scene to restart from");
+  const fs::path ckpt = dir / "checkpoint.bin";
+  if (!fs::exists(ckpt)) throw InputError(ckpt.string() + ": no checkpoint to restart from");
+  Scene scene = parse_scene_file(scene_file.string());
+  std::vector<io::Blob> blobs;
+  try {
+    blobs = io::read_checkpoint(ckpt);
+  } catch (const std::exception& e) {
+    throw InputError(e.what());
+  }
+  return drive(scene, options, log, dir, &blobs);
+}
+
+}  // namespace mmpm

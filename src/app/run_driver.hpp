@@ -1,0 +1,38 @@
+// `mmpm run`: drives a Simulation to its end, writing snapshots, the time
+// series, checkpoints, summary.json and the timing table.
+#pragma once
+
+#include <filesystem>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "scene/scene.hpp"
+
+namespace mmpm {
+
+struct RunOptions {
+  std::filesystem::path out;  // empty: scene.output.directory
+  int threads = 0;            // 0: OpenMP default
+  bool quiet = false;
+  bool force = false;         // run even above the stability limit
+  bool progress = true;       // progress line when stderr is a terminal
+  bool timing_table = true;
+};
+
+struct RunOutcome {
+  int exit_code = 0;          // 0 ok, 2 bad input, 3 unstable / failed
+  std::string message;        // error text when exit_code != 0
+  nlohmann::json summary;     // summary.json contents when the run completed
+  std::filesystem::path directory;
+};
+
+// Runs a scene from its start, or (restart_dir non-empty) continues the run
+// whose checkpoint and resolved scene are in restart_dir.
+RunOutcome run_scene(const Scene& scene, const RunOptions& options, std::ostream& log);
+RunOutcome restart_run(const std::filesystem::path& restart_dir, const RunOptions& options,
+                       std::ostream& log);
+
+}  // namespace mmpm

@@ -1,0 +1,99 @@
+#include "io/xdmf.hpp"
+
+#include <charconv>
+#include <sstream>
+#include <stdexcept>
+
+namespace mmpm::io {
+
+namespace {
+
+std::string escaped(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      case '\'': out += "&apos;"; break;
+      default: out += c;
+    }
+  }
+  return out;
+}
+
+// Shortest text that reads back to the same double: ParaView's time values
+// then match the file's "time" attributes exactly.
+std::string exact(double value) {
+  char buffer[32];
+  const auto [end, error] = std::to_chars(buffer, buffer + sizeof buffer, value);
+  if (error != std::errc()) throw std::runtime_error("xdmf: cannot format a time value");
+  return std::string(buffer, end);
+}
+
+const char* kind_name(AttributeKind kind) {
+  switch (kind) {
+    case AttributeKind::scalar: return "Scalar";
+    case AttributeKind::vector: return "Vector";
+    case AttributeKind::tensor: return "Tensor";
+    case AttributeKind::matrix: return "Matrix";
+  }
+  return "Matrix";
+}
+
+void data_item(std::ostringstream& out, const std::string& indent, std::size_t rows, int columns,
+               const char* number_type, const std::string& h5_file, const std::string& dataset) {
+  out << indent << "<DataItem Dimensions=\"" << rows;
+  if (columns > 0) out << ' ' << columns;
+  out << "\" NumberType=\"" << number_type << "\" Precision=\"8\" Format=\"HDF\">"
+      << escaped(h5_file) << ':' << escaped(dataset) << "</DataItem>\n";
+}
+
+}  // namespace
+
+AttributeKind attribute_kind(int components, int dimension) {
+  if (components == 1) return AttributeKind::scalar;
+  if (components == dimension) return AttributeKind::vector;
+  if (components == 9 && dimension == 3) return AttributeKind::tensor;
+  return AttributeKind::matrix;
+}
+
+std::string xdmf_document(const std::string& h5_file, const std::vector<XdmfSnapshot>& snapshots) {
+  std::ostringstream out;
+  out << "<?xml version=\"1.0\" ?>\n"
+      << "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n"
+      << "<Xdmf Version=\"3.0\">\n"
+      << "  <Domain>\n"
+      << "    <Grid Name=\"particles\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+  for (const XdmfSnapshot& s : snapshots) {
+    if (s.dimension != 2 && s.dimension != 3) {
+      throw std::invalid_argument("xdmf: dimension must be 2 or 3");
+    }
+    const std::string in = "        ";
+    out << "      <Grid Name=\"step_" << s.step << "\" GridType=\"Uniform\">\n"
+        << in << "<Time Value=\"" << exact(s.time) << "\"/>\n"
+        // One vertex cell per particle, with explicit connectivity: readers
+        // differ on what an implicit Polyvertex topology means.
+        << in << "<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" << s.count
+        << "\" NodesPerElement=\"1\">\n";
+    data_item(out, in + "  ", s.count, 0, "Int", h5_file, s.connectivity);
+    out << in << "</Topology>\n"
+        << in << "<Geometry GeometryType=\"" << (s.dimension == 2 ? "XY" : "XYZ") << "\">\n";
+    data_item(out, in + "  ", s.count, s.dimension, "Float", h5_file, s.position);
+    out << in << "</Geometry>\n";
+    for (const XdmfField& f : s.fields) {
+      out << in << "<Attribute Name=\"" << escaped(f.name) << "\" AttributeType=\""
+          << kind_name(f.kind) << "\" Center=\"Node\">\n";
+      data_item(out, in + "  ", s.count, f.stored_components, "Float", h5_file, f.dataset);
+      out << in << "</Attribute>\n";
+    }
+    out << "      </Grid>\n";
+  }
+  out << "    </Grid>\n"
+      << "  </Domain>\n"
+      << "</Xdmf>\n";
+  return out.str();
+}
+
+}  // namespace mmpm::io

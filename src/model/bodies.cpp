@@ -1,0 +1,230 @@
+#include "model/bodies.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "scene/error.hpp"
+
+namespace mmpm {
+namespace {
+
+// Centre of rotation: the centre of the unrotated bounding box.
+Vec3 box_center(const BodySpec& b) {
+  if (b.shape == BodyShape::polygon && !b.points.empty()) {
+    Vec3 lo = b.points.front(), hi = b.points.front();
+    for (const auto& p : b.points)
+      for (int d = 0; d < 2; ++d) lo[d] = std::min(lo[d], p[d]), hi[d] = std::max(hi[d], p[d]);
+    return {0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.0};
+  }
+  return {0.5 * (b.min[0] + b.max[0]), 0.5 * (b.min[1] + b.max[1]), 0.5 * (b.min[2] + b.max[2])};
+}
+
+// Global → body frame for a box rotated by `rotate` degrees about its centre (2D).
+Vec3 to_body_frame(const BodySpec& b, const Vec3& x) {
+  if (b.rotate == 0.0) return x;
+  const Vec3 c = box_center(b);
+  const double a = -b.rotate * std::numbers::pi / 180.0;
+  const double dx = x[0] - c[0], dy = x[1] - c[1];
+  return {c[0] + std::cos(a) * dx - std::sin(a) * dy, c[1] + std::sin(a) * dx + std::cos(a) * dy, x[2]};
+}
+
+Vec3 rotate_vector(const BodySpec& b, const Vec3& v) {
+  if (b.rotate == 0.0) return v;
+  const double a = b.rotate * std::numbers::pi / 180.0;
+  return {std::cos(a) * v[0] - std::sin(a) * v[1], std::sin(a) * v[0] + std::cos(a) * v[1], v[2]};
+}
+
+bool inside_polygon(const std::vector<Vec3>& pts, double x, double y) {
+  bool in = false;
+  for (std::size_t i = 0, j = pts.size() - 1; i < pts.size(); j = i++) {
+    const double xi = pts[i][0], yi = pts[i][1], xj = pts[j][0], yj = pts[j][1];
+    if ((yi > y) != (yj > y) && x < (xj - xi) * (y - yi) / (yj - yi) + xi) in = !in;
+  }
+  return in;
+}
+
+// Bounding box of a body in global coordinates.
+std::pair<Vec3, Vec3> bounds(const BodySpec& b, int dim) {
+  Vec3 lo{0, 0, 0}, hi{0, 0, 0};
+  switch (b.shape) {
+    case BodyShape::box: {
+      lo = b.min, hi = b.max;
+      if (b.rotate != 0.0) {
+        Vec3 c = box_center(b);
+        double r = 0;
+        for (int d = 0; d < 2; ++d) r += 0.25 * (b.max[d] - b.min[d]) * (b.max[d] - b.min[d]);
+        r = std::sqrt(r);
+        for (int d = 0; d < 2; ++d) lo[d] = c[d] - r, hi[d] = c[d] + r;
+      }
+      break;
+    }
+    case BodyShape::disk:
+    case BodyShape::sphere:
+      for (int d = 0; d < dim; ++d) lo[d] = b.center[d] - b.radius, hi[d] = b.center[d] + b.radius;
+      break;
+    case BodyShape::cylinder:
+      for (int d = 0; d < 2; ++d) lo[d] = b.center[d] - b.radius, hi[d] = b.center[d] + b.radius;
+      lo[2] = b.center[2], hi[2] = b.center[2] + b.length;
+      break;
+    case BodyShape::polygon: {
+      const Vec3 c = box_center(b);
+      double r = 0;
+      for (const auto& p : b.points) r = std::max(r, std::hypot(p[0] - c[0], p[1] - c[1]));
+      lo = {c[0] - r, c[1] - r, 0}, hi = {c[0] + r, c[1] + r, 0};
+      break;
+    }
+  }
+  if (b.clip) {
+    for (int d = 0; d < dim; ++d) {
+      lo[d] = std::max(lo[d], b.clip->first[d]);
+      hi[d] = std::min(hi[d], b.clip->second[d]);
+    }
+  }
+  return {lo, hi};
+}
+
+}  // namespace
+
+bool inside_body(const BodySpec& b, const Vec3& x, int dim) {
+  if (b.clip) {
+    for (int d = 0; d < dim; ++d)
+      if (x[d] < b.clip->first[d] || x[d] > b.clip->second[d]) return false;
+  }
+  switch (b.shape) {
+    case BodyShape::box: {
+      const Vec3 u = to_body_frame(b, x);
+      for (int d = 0; d < dim; ++d)
+        if (u[d] < b.min[d] || u[d] > b.max[d]) return false;
+      return true;
+    }
+    case BodyShape::disk:
+    case BodyShape::sphere: {
+      double r2 = 0;
+      for (int d = 0; d < dim; ++d) r2 += (x[d] - b.center[d]) * (x[d] - b.center[d]);
+      return r2 <= b.radius * b.radius;
+    }
+    case BodyShape::cylinder: {
+      const double r2 = (x[0] - b.center[0]) * (x[0] - b.center[0]) + (x[1] - b.center[1]) * (x[1] - b.center[1]);
+      return r2 <= b.radius * b.radius && x[2] >= b.center[2] && x[2] <= b.center[2] + b.length;
+    }
+    case BodyShape::polygon: {
+      const Vec3 u = to_body_frame(b, x);
+      return inside_polygon(b.points, u[0], u[1]);
+    }
+  }
+  return false;
+}
+
+ParticleSeeds make_particles(const Scene& scene) {
+  const int dim = scene.simulation.dimension;
+  const auto& g = scene.grid;
+  ParticleSeeds out;
+  std::vector<char> alive;
+  std::vector<int> material_index(scene.bodies.size(), -1);
+  for (std::size_t b = 0; b < scene.bodies.size(); ++b)
+    for (std::size_t m = 0; m < scene.materials.size(); ++m)
+      if (scene.materials[m].name == scene.bodies[b].material) material_index[b] = int(m);
+
+  for (std::size_t bi = 0; bi < scene.bodies.size(); ++bi) {
+    const BodySpec& body = scene.bodies[bi];
+    // Later bodies replace earlier particles inside them.
+    for (std::size_t p = 0; p < out.x.size(); ++p)
+      if (alive[p] && inside_body(body, out.x[p], dim)) alive[p] = 0;
+    const int ppc = body.particles_per_cell;
+    auto [lo, hi] = bounds(body, dim);
+    std::array<int, 3> c0{0, 0, 0}, c1{0, 0, 0};
+    for (int d = 0; d < dim; ++d) {
+      c0[d] = std::max(0, int(std::floor((lo[d] - g.origin[d]) / g.cell[d])));
+      c1[d] = std::min(g.cells[d] - 1, int(std::floor((hi[d] - g.origin[d]) / g.cell[d])));
+    }
+    double volume = 1;
+    Vec3 half{0, 0, 0};
+    for (int d = 0; d < dim; ++d) {
+      volume *= g.cell[d] / ppc;
+      half[d] = 0.5 / ppc;
+    }
+    if (dim == 2) volume *= scene.simulation.thickness;
+    const int sub_z = dim == 3 ? ppc : 1;
+    std::size_t added = 0;
+    for (int cz = c0[2]; cz <= (dim == 3 ? c1[2] : 0); ++cz)
+      for (int cy = c0[1]; cy <= c1[1]; ++cy)
+        for (int cx = c0[0]; cx <= c1[0]; ++cx)
+          for (int kz = 0; kz < sub_z; ++kz)
+            for (int ky = 0; ky < ppc; ++ky)
+              for (int kx = 0; kx < ppc; ++kx) {
+                Vec3 x{g.origin[0] + (cx + (kx + 0.5) / ppc) * g.cell[0],
+                       g.origin[1] + (cy + (ky + 0.5) / ppc) * g.cell[1], 0.0};
+                if (dim == 3) x[2] = g.origin[2] + (cz + (kz + 0.5) / ppc) * g.cell[2];
+                if (!inside_body(body, x, dim)) continue;
+                out.x.push_back(x);
+                out.v.push_back(body.velocity);
+                out.volume.push_back(volume);
+                out.half_width.push_back(half);
+                out.material.push_back(material_index[bi]);
+                out.body.push_back(int(bi));
+                out.traction_force.push_back({0, 0, 0});
+                out.load.push_back(-1);
+                alive.push_back(1);
+                ++added;
+              }
+    if (added == 0)
+      throw InputError(located(body.where.file, body.where.line, "shape",
+                               "body '" + body.name + "' holds no particle on this grid "
+                               "(smaller than a particle spacing, or outside the grid)"));
+  }
+  // Drop replaced particles, keeping the order.
+  std::size_t w = 0;
+  for (std::size_t p = 0; p < out.x.size(); ++p) {
+    if (!alive[p]) continue;
+    out.x[w] = out.x[p], out.v[w] = out.v[p], out.volume[w] = out.volume[p];
+    out.half_width[w] = out.half_width[p], out.material[w] = out.material[p];
+    out.body[w] = out.body[p], out.traction_force[w] = out.traction_force[p];
+    out.load[w] = out.load[p];
+    ++w;
+  }
+  out.x.resize(w), out.v.resize(w), out.volume.resize(w), out.half_width.resize(w);
+  out.material.resize(w), out.body.resize(w), out.traction_force.resize(w), out.load.resize(w);
+
+  // Traction loads: the outermost particle layer of a box face shares the
+  // face's total force (traction × face area) equally.
+  for (std::size_t li = 0; li < scene.loads.size(); ++li) {
+    const LoadSpec& load = scene.loads[li];
+    if (load.kind != LoadKind::traction) continue;
+    int bi = -1;
+    for (std::size_t b = 0; b < scene.bodies.size(); ++b)
+      if (scene.bodies[b].name == load.body) bi = int(b);
+    const BodySpec& body = scene.bodies[std::size_t(bi)];
+    if (body.shape != BodyShape::box)
+      throw InputError(located(load.where.file, load.where.line, "where",
+                               "traction loads act on box bodies only"));
+    const int ax = load.face_axis;
+    const double spacing = scene.grid.cell[std::size_t(ax)] / body.particles_per_cell;
+    double extreme = load.face_max ? -1e300 : 1e300;
+    for (std::size_t p = 0; p < w; ++p) {
+      if (out.body[p] != bi) continue;
+      const double u = to_body_frame(body, out.x[p])[std::size_t(ax)];
+      extreme = load.face_max ? std::max(extreme, u) : std::min(extreme, u);
+    }
+    std::vector<std::size_t> face;
+    for (std::size_t p = 0; p < w; ++p) {
+      if (out.body[p] != bi) continue;
+      const double u = to_body_frame(body, out.x[p])[std::size_t(ax)];
+      if (std::abs(u - extreme) < 0.5 * spacing) face.push_back(p);
+    }
+    double area = dim == 2 ? scene.simulation.thickness : 1.0;
+    for (int d = 0; d < dim; ++d)
+      if (d != ax) area *= body.max[d] - body.min[d];
+    const Vec3 t = rotate_vector(body, load.traction);
+    for (std::size_t p : face) {
+      if (out.load[p] >= 0)
+        throw InputError(located(load.where.file, load.where.line, "where",
+                                 "two traction loads act on the same particles"));
+      out.load[p] = int(li);
+      for (int d = 0; d < dim; ++d) out.traction_force[p][d] = t[d] * area / double(face.size());
+    }
+  }
+  return out;
+}
+
+}  // namespace mmpm

@@ -1,0 +1,31 @@
+// Bodies → particles: each body fills the grid-aligned lattice of
+// particles_per_cell^D points per cell that lie inside its shape. Where
+// bodies overlap, the later body replaces the earlier one's particles.
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "scene/scene.hpp"
+
+namespace mmpm {
+
+struct ParticleSeeds {
+  std::vector<Vec3> x;
+  std::vector<Vec3> v;
+  std::vector<double> volume;   // area * thickness in 2D
+  std::vector<Vec3> half_width; // uGIMP half-width in cell units per direction
+  std::vector<int> material;
+  std::vector<int> body;
+  std::vector<Vec3> traction_force;  // external force on the particle (before the ramp)
+  std::vector<int> load;             // index of the traction load acting on it, or -1
+};
+
+// Throws InputError when a body holds no particle or a traction load has
+// no particle on its face.
+ParticleSeeds make_particles(const Scene& scene);
+
+// Whether point x lies inside body b (in global coordinates).
+bool inside_body(const BodySpec& b, const Vec3& x, int dimension);
+
+}  // namespace mmpm

@@ -1,0 +1,168 @@
+// The resolved scene: plain data, no behaviour. Parsed from TOML by
+// scene/parse.cpp (every field below maps to a key of SCENE.md). Vectors of
+// length 3 are used for every dimension; only the first `dimension` entries
+// are meaningful.
+#pragma once
+
+#include <array>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace mmpm {
+
+using Vec3 = std::array<double, 3>;
+
+enum class Plane { strain, stress };
+enum class Scheme { USL, USF, MUSL };
+enum class Precision { float64, float32 };
+enum class ShapeKind { linear, gimp, bspline2, bspline3 };
+enum class MaterialType { isotropic, transverse, neohookean, rigid };
+enum class BodyShape { box, disk, sphere, cylinder, polygon };
+enum class Law { stick, frictionless, friction, interface, separate };
+enum class NormalMethod { mvg, avg, specified, radial, rigid };
+enum class Separation { displacement, position };
+enum class Integration { explicit_, exact };
+enum class TractionLaw { linear, bilinear };  // bilinear: stiff in compression (ALGORITHM §3.2)
+enum class LoadKind { traction, gravity };
+
+// A source position for messages ("scene.toml:12: key 'E'").
+struct Where {
+  std::string file;
+  int line = 0;
+  std::string key;
+};
+
+struct SimulationSpec {
+  int dimension = 2;
+  Plane plane = Plane::strain;
+  double thickness = 1.0;
+  double end_time = 0.0;
+  double cfl = 0.5;
+  std::optional<double> dt;  // explicit time step overrides cfl
+  Scheme scheme = Scheme::USL;
+  double flip = 1.0;
+  Precision precision = Precision::float64;
+  Law default_law = Law::stick;
+  bool force = false;  // run even when dt exceeds the stability limit
+  int sort_every = 0;  // 0 = re-bin only when a particle changes tile
+};
+
+struct GridSpec {
+  Vec3 origin{0, 0, 0};
+  Vec3 cell{1, 1, 1};
+  std::array<int, 3> cells{1, 1, 1};
+  ShapeKind shape = ShapeKind::gimp;
+  double damping = 0.0;  // 1/time
+  int tile = 0;          // tile edge in cells for the colored scatter; 0 = automatic
+};
+
+// Time table for a rigid material's velocity: piecewise linear, held after the last row.
+struct VelocityTable {
+  std::vector<double> time;
+  std::vector<Vec3> velocity;
+};
+
+struct MaterialSpec {
+  std::string name;
+  MaterialType type = MaterialType::isotropic;
+  double density = 1.0;
+  double E = 0, nu = 0;                        // isotropic, neohookean
+  double EA = 0, ET = 0, GA = 0, nuA = 0, nuT = 0;  // transverse
+  Vec3 axis{0, 1, 0};                          // transverse: the A (fibre) axis
+  VelocityTable velocity;                      // rigid (one row = constant)
+  Where where;
+};
+
+struct BodySpec {
+  std::string name;
+  std::string material;
+  BodyShape shape = BodyShape::box;
+  Vec3 min{0, 0, 0}, max{0, 0, 0};   // box
+  double rotate = 0.0;              // degrees about the body's centre (2D)
+  Vec3 center{0, 0, 0};             // disk, sphere, cylinder
+  double radius = 0.0;
+  double length = 0.0;              // cylinder (3D): along axis z from center
+  std::vector<Vec3> points;         // polygon
+  int particles_per_cell = 2;       // per direction
+  Vec3 velocity{0, 0, 0};
+  std::optional<std::pair<Vec3, Vec3>> clip;  // fill only inside this box
+  Where where;
+};
+
+struct InteractionSpec {
+  std::array<std::string, 2> materials;
+  Law law = Law::stick;
+  double friction = 0.0;
+  double Dn = 0.0, Dt = 0.0;  // MPa/mm; +inf = "perfect"
+  TractionLaw traction_law = TractionLaw::linear;
+  double Dn_compression = std::numeric_limits<double>::infinity();  // bilinear
+  NormalMethod normal = NormalMethod::mvg;
+  Vec3 normal_vector{1, 0, 0};
+  Vec3 center{0, 0, 0};  // radial
+  Separation separation = Separation::displacement;
+  double min_volume = 0.0;  // fraction of the cell volume
+  bool force_limit = true;
+  Integration integration = Integration::explicit_;
+  Where where;
+};
+
+enum class BoundaryWhere { face, plane, box };
+
+struct BoundarySpec {
+  BoundaryWhere kind = BoundaryWhere::face;
+  int face_axis = 0;       // face: 0,1,2
+  bool face_max = false;   // face: min or max side
+  int plane_axis = 0;      // plane: { x = value }
+  double plane_value = 0;
+  Vec3 box_min{0, 0, 0}, box_max{0, 0, 0};
+  std::array<bool, 3> fix{false, false, false};
+  Vec3 displacement{0, 0, 0};  // prescribed displacement of the fixed components
+  double ramp = 0.0;           // time over which `displacement` is reached; 0 = at once? see parse
+  bool has_displacement = false;
+  std::string label;  // e.g. "y_min" — used to name the reaction force in the series
+  Where where;
+};
+
+struct LoadSpec {
+  LoadKind kind = LoadKind::traction;
+  std::string body;   // traction
+  int face_axis = 0;  // traction: face of the body ("x_min" ...)
+  bool face_max = false;
+  Vec3 traction{0, 0, 0};      // in the body's frame
+  Vec3 acceleration{0, 0, 0};  // gravity
+  double ramp = 0.0;
+  Where where;
+};
+
+struct OutputSpec {
+  double every = 0.0;  // time between particle snapshots; 0 = only the last
+  std::vector<std::string> fields{"displacement", "velocity", "stress", "material"};
+  int series = 100;              // steps between series rows
+  double checkpoint_minutes = 0; // wall minutes between checkpoints; 0 = none
+  std::string directory;         // default results/<scene name>
+};
+
+struct StopSpec {
+  bool enabled = false;
+  double kinetic_ratio = 1e-8;
+  int hold_steps = 1000;
+};
+
+struct Scene {
+  std::string name;        // from the file name (stem) unless [simulation] name
+  std::string source_file;
+  std::string source_text; // resolved TOML (after --set), stored with results
+  SimulationSpec simulation;
+  GridSpec grid;
+  std::vector<MaterialSpec> materials;
+  std::vector<BodySpec> bodies;
+  std::vector<InteractionSpec> interactions;
+  std::vector<BoundarySpec> boundaries;
+  std::vector<LoadSpec> loads;
+  OutputSpec output;
+  StopSpec stop;
+};
+
+}  // namespace mmpm

@@ -1,0 +1,30 @@
+// Grid boundary conditions resolved to node lists (SCENE.md [[boundary]]).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "scene/scene.hpp"
+
+namespace mmpm {
+
+struct BoundaryNodes {
+  std::string label;
+  std::vector<std::uint32_t> nodes;  // ascending
+  std::array<bool, 3> fix{false, false, false};
+  Vec3 displacement{0, 0, 0};
+  double ramp = 0;
+  bool moving = false;
+};
+
+// Throws InputError when a plane does not lie on grid nodes or a boundary holds no node.
+std::vector<BoundaryNodes> resolve_boundaries(const Scene& scene);
+
+// Velocity of the fixed components over the step [t, t + dt]: the support's
+// displacement follows displacement * min(t / ramp, 1), so the step velocity
+// is the exact difference quotient and the final displacement is reached exactly.
+Vec3 boundary_velocity(const BoundaryNodes& b, double t, double dt);
+
+}  // namespace mmpm

@@ -1,0 +1,26 @@
+// Which material velocity fields exist and how each pair of fields interacts
+// (ALGORITHM §1; SCENE.md: materials named in no interaction share one
+// field; rigid materials always have their own; a pair without an
+// interaction of its own uses [simulation] default_law).
+#pragma once
+
+#include <vector>
+
+#include "scene/scene.hpp"
+
+namespace mmpm {
+
+struct FieldPlan {
+  int fields = 1;
+  std::vector<int> field_of_material;   // per material
+  std::vector<unsigned char> rigid;     // per field
+  std::vector<int> rigid_material;      // per field: material index, or -1
+  std::vector<InteractionSpec> laws;    // the distinct interactions in use
+  std::vector<int> pair;                // fields x fields → index into laws, -1 = none
+  bool multimaterial = false;           // a multimaterial pass exists
+  bool position_separation = false;     // mx holds positions (else displacements)
+};
+
+FieldPlan plan_fields(const Scene& scene);
+
+}  // namespace mmpm

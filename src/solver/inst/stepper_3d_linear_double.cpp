@@ -1,0 +1,10 @@
+// Instantiation: 3D, linear shape functions, double precision.
+#include "solver/instantiations.hpp"
+#include "solver/stepper.hpp"
+
+namespace mmpm {
+template class Stepper<3, LinearShape, double>;
+std::unique_ptr<Simulation> make_stepper_3_linear_double(const Scene& scene) {
+  return std::make_unique<Stepper<3, LinearShape, double>>(scene);
+}
+}  // namespace mmpm

@@ -1,0 +1,102 @@
+// The multimaterial stage of a step: builds the pass configuration from the
+// scene once, then per step finds the multimaterial nodes and runs passes
+// A and B (ALGORITHM §2 steps 3 and 5). Absent entirely (no list, no
+// arrays, no work) when the scene has one material field.
+#pragma once
+
+#include <limits>
+#include <vector>
+
+#include "kernels/multimaterial.hpp"
+#include "solver/field_plan.hpp"
+#include "solver/simulation.hpp"
+
+namespace mmpm {
+
+template <int D, class Real>
+class MultimaterialStage {
+ public:
+  void setup(const Scene& scene, const FieldPlan& plan, const GridView<D, Real>& grid, Real mass_threshold) {
+    enabled_ = plan.multimaterial;
+    fields_ = plan.fields;
+    stats_.reset(plan.fields);
+    if (!enabled_) return;
+    pair_ = plan.pair;
+    rigid_ = plan.rigid;
+    double cell = 1;
+    for (int d = 0; d < D; ++d) cell *= double(grid.h[d]);  // area in 2D: grid.vol holds areas
+    for (const InteractionSpec& it : plan.laws) {
+      PairParams<Real> pp;
+      pp.law = it.law;
+      pp.friction = Real(it.friction);
+      pp.Dn = Real(it.Dn);
+      pp.Dt = Real(it.Dt);
+      pp.traction_law = it.traction_law;
+      pp.Dn_compression = Real(it.Dn_compression);
+      pp.normal_method = it.normal;
+      for (int d = 0; d < 3; ++d) {
+        pp.normal_vector[d] = Real(it.normal_vector[d]);
+        pp.radial_center[d] = Real(it.center[d]);
+      }
+      pp.first_field = -1;
+      for (std::size_t m = 0; m < scene.materials.size(); ++m)
+        if (scene.materials[m].name == it.materials[0]) pp.first_field = plan.field_of_material[m];
+      pp.separation = it.separation;
+      pp.omega_min = Real(it.min_volume * cell);
+      pp.force_limit = it.force_limit;
+      pp.integration = it.integration;
+      if (it.law == Law::interface) has_interface_ = true;
+      params_.push_back(pp);
+    }
+    cfg_.fields = plan.fields;
+    cfg_.pair = pair_.data();
+    cfg_.params = params_.data();
+    cfg_.rigid = rigid_.data();
+    cfg_.thickness = D == 2 ? Real(scene.simulation.thickness) : Real(1);
+    // Contact and interfaces ignore a material whose nodal mass is a sliver
+    // (ALGORITHM §4.3): 1e-6 of the lightest particle, well above round-off.
+    cfg_.mass_threshold = mass_threshold * Real(1000);
+  }
+
+  bool has_interface_forces() const { return enabled_ && has_interface_; }
+
+  void pass_a(GridView<D, Real>& grid, double dt, double /*time*/, long /*step*/) {
+    if (!enabled_) return;
+    cfg_.dt = Real(dt);
+    find_multimaterial_nodes(grid, cfg_.mass_threshold, list_);
+    stats_.reset(fields_);
+    multimaterial_pass_a(grid, list_, cfg_, stats_, stick_flags_);
+  }
+  void pass_b(GridView<D, Real>& grid) {
+    if (!enabled_) return;
+    multimaterial_pass_b(grid, list_, cfg_, stick_flags_, stats_);
+  }
+
+  StepCounters counters() const {
+    StepCounters c;
+    c.multimaterial_nodes = long(list_.size());
+    c.nodes_3plus = stats_.nodes_3plus;
+    c.force_limited_nodes = stats_.force_limited;
+    return c;
+  }
+  double interface_energy() const { return stats_.interface_energy; }
+  void set_interface_energy(double e) { stats_.interface_energy = e; }
+  Vec3 rigid_reaction(int field) const {
+    if (std::size_t(field) >= stats_.rigid_reaction.size()) return {0, 0, 0};
+    const auto& r = stats_.rigid_reaction[std::size_t(field)];
+    return {r[0], r[1], r[2]};
+  }
+
+ private:
+  bool enabled_ = false, has_interface_ = false;
+  int fields_ = 1;
+  std::vector<int> pair_;
+  std::vector<unsigned char> rigid_;
+  std::vector<PairParams<Real>> params_;
+  MMConfig<D, Real> cfg_;
+  MMStats stats_;
+  std::vector<std::uint32_t> list_;
+  std::vector<unsigned char> stick_flags_;
+};
+
+}  // namespace mmpm

@@ -1,0 +1,85 @@
+// The solver seen from outside: one object per run, built from a resolved
+// scene. The templated stepper (solver/stepper.hpp) implements it for every
+// (dimension, shape function, precision) instantiation; the run driver,
+// tests and benchmarks use only this interface.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "io/checkpoint.hpp"
+#include "io/run_writer.hpp"
+#include "scene/scene.hpp"
+
+namespace mmpm {
+
+// A run that went unstable: names the stage, step and particle or node.
+class SimulationError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct Energies {
+  double kinetic = 0;            // particles: sum m v^2 / 2
+  double strain = 0;             // state function of the stresses / F
+  double interface = 0;          // sum over multimaterial nodes (ALGORITHM §3.2)
+  double external_work = 0;      // tractions, gravity, moving supports
+  double damping = 0;            // removed by grid damping
+  double kinetic_unresolved = 0; // particle KE minus the KE of the grid velocity field
+};
+
+struct StepCounters {
+  long multimaterial_nodes = 0;
+  long nodes_3plus = 0;
+  long force_limited_nodes = 0;
+};
+
+struct Reaction {
+  std::string name;  // "y_min", "rigid:<material>"
+  Vec3 force{0, 0, 0};
+};
+
+inline constexpr std::array<const char*, 7> kStageNames = {
+    "sort", "p2g", "multimaterial", "grid", "g2p", "constitutive", "output"};
+enum Stage { kStageSort, kStageP2G, kStageMultimaterial, kStageGrid, kStageG2P, kStageConstitutive, kStageOutput, kStageCount };
+
+class Simulation {
+ public:
+  virtual ~Simulation() = default;
+  virtual void step() = 0;  // throws SimulationError
+  virtual long step_count() const = 0;
+  virtual double time() const = 0;
+  virtual double dt() const = 0;
+  virtual std::size_t particle_count() const = 0;
+  virtual std::size_t node_count() const = 0;
+  virtual int field_count() const = 0;
+  virtual int tile_edge() const = 0;
+  virtual Energies energies() const = 0;  // evaluated now (not cached)
+  virtual StepCounters counters() const = 0;
+  virtual std::vector<Reaction> reactions() const = 0;  // from the last step
+  // Particle quantities by name: position, displacement, velocity, stress,
+  // material, mass, volume, body (components per particle, particle-major).
+  virtual io::ParticleField particle_field(const std::string& name) const = 0;
+  virtual io::Snapshot snapshot(const std::vector<std::string>& fields) const = 0;
+  // Sets a per-particle quantity (velocity: D values per particle, in the
+  // current particle order) — for initial conditions the scene keys cannot express.
+  virtual void set_particle_field(const std::string& name, const std::vector<double>& values) = 0;
+  virtual std::array<double, kStageCount> stage_seconds() const = 0;
+  virtual std::array<long, kStageCount> stage_calls() const = 0;
+  virtual std::vector<io::Blob> save_state() const = 0;
+  virtual void load_state(const std::vector<io::Blob>& blobs) = 0;
+  virtual std::string instantiation() const = 0;  // e.g. "2D gimp double"
+};
+
+// Picks the instantiation from the scene. Throws InputError for scenes the
+// kernels cannot run.
+std::unique_ptr<Simulation> make_simulation(const Scene& scene);
+
+// Stable time step for the scene: cfl * min cell / (max wave speed + max body speed).
+double stable_time_step(const Scene& scene);
+double critical_time_step(const Scene& scene);  // the same with cfl = 1
+
+}  // namespace mmpm

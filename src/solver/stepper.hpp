@@ -1,0 +1,138 @@
+// The explicit MPM step for one (dimension, shape function, precision)
+// instantiation: ALGORITHM §2 as a list of stages over SoA data. Setup
+// decides once which arrays exist and which stages run.
+#pragma once
+
+#include <omp.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <sstream>
+
+#include "kernels/binning.hpp"
+#include "kernels/constitutive.hpp"
+#include "kernels/g2p.hpp"
+#include "kernels/grid_update.hpp"
+#include "kernels/p2g.hpp"
+#include "kernels/reduce.hpp"
+#include "kernels/shape.hpp"
+#include "model/bodies.hpp"
+#include "model/material.hpp"
+#include "scene/error.hpp"
+#include "solver/boundary.hpp"
+#include "solver/field_plan.hpp"
+#include "solver/multimaterial_stage.hpp"
+#include "solver/simulation.hpp"
+#include "solver/storage.hpp"
+
+namespace mmpm {
+
+template <int D, class Shape, class Real>
+class Stepper final : public Simulation {
+  static constexpr int NS = kStressComponents<D>;
+  using Clock = std::chrono::steady_clock;
+
+ public:
+  explicit Stepper(const Scene& scene);
+
+  void step() override;
+  long step_count() const override { return step_; }
+  double time() const override { return time_; }
+  double dt() const override { return dt_; }
+  std::size_t particle_count() const override { return P_.n; }
+  std::size_t node_count() const override { return G_.nodes; }
+  int field_count() const override { return plan_.fields; }
+  int tile_edge() const override { return tiles_.T; }
+  Energies energies() const override;
+  StepCounters counters() const override { return mm_.counters(); }
+  std::vector<Reaction> reactions() const override;
+  io::ParticleField particle_field(const std::string& name) const override;
+  io::Snapshot snapshot(const std::vector<std::string>& fields) const override;
+  void set_particle_field(const std::string& name, const std::vector<double>& values) override;
+  std::array<double, kStageCount> stage_seconds() const override { return stage_s_; }
+  std::array<long, kStageCount> stage_calls() const override { return stage_calls_; }
+  std::vector<io::Blob> save_state() const override;
+  void load_state(const std::vector<io::Blob>& blobs) override;
+  std::string instantiation() const override {
+    return std::to_string(D) + "D " + Shape::name + " " + (sizeof(Real) == 8 ? "double" : "float");
+  }
+
+  // Exposed for tests and benchmarks.
+  ParticleView<D, Real>& particles() { return P_; }
+  GridView<D, Real>& grid() { return G_; }
+
+ private:
+  struct KeyFn {
+    const Stepper* s;
+    std::uint32_t tile(std::size_t p) const { return s->tile_of_position(p); }
+    std::uint32_t tile_of_key(std::uint32_t k) const { return k / s->tiles_.keys_per_tile; }
+  };
+
+  void setup_particles(const ParticleSeeds& seeds);
+  void setup_grid();
+  std::uint32_t key_of_position(std::size_t p) const;
+  std::uint32_t tile_of_position(std::size_t p) const { return key_of_position(p) / tiles_.keys_per_tile; }
+  void sort_particles();
+  void rebuild_ranges();
+  void zero_grid(bool mm);
+  template <unsigned What>
+  void p2g(const char* stage_label);
+  template <unsigned What>
+  void g2p();
+  void constitutive();
+  void grid_update_stage();
+  void finish_velocities(bool with_dvel);
+  void apply_boundaries(bool with_dvel);
+  void update_tractions();
+  void check_volumes();
+  [[noreturn]] void fail_particle(const char* stage, std::size_t p, const std::string& why) const;
+  void tic() { t0_ = Clock::now(); }
+  void toc(Stage s) {
+    stage_s_[s] += std::chrono::duration<double>(Clock::now() - t0_).count();
+    ++stage_calls_[s];
+  }
+
+  Scene scene_;
+  FieldPlan plan_;
+  std::vector<MaterialModel> materials_;
+  std::vector<BoundaryNodes> boundaries_;
+  double dt_ = 0, time_ = 0;
+  long step_ = 0;
+  Real thickness_ = 1;
+  Real mass_threshold_ = 0;
+  std::array<double, 3> gravity_{0, 0, 0};
+  bool has_gravity_ = false, has_traction_ = false;
+
+  ColumnSet<Real> pcols_, gcols_;
+  std::vector<std::uint8_t> scratch_bytes_;
+  ParticleView<D, Real> P_;
+  GridView<D, Real> G_;
+  GridVelocity<D, Real> GV_;
+  std::vector<Real> scratch_;
+  std::vector<std::uint32_t> perm_, offsets_, scratch_keys_;
+
+  TileLayout<D> tiles_;
+  std::vector<std::uint32_t> tile_begin_;               // per tile, size tile_count + 1
+  std::array<std::vector<std::uint32_t>, 8> color_tiles_;  // non-empty tiles per color
+  bool dirty_ = true;
+
+  // Per-material particle lists (only when several materials share the step).
+  std::vector<std::vector<std::uint32_t>> material_particles_;
+  double traction_ramp_end_ = 0;  // tractions are constant after the last load ramp
+
+  MultimaterialStage<D, Real> mm_;
+  std::vector<double> rigid_velocity_now_;  // per field x 3 at t + dt
+  std::vector<Vec3> boundary_reaction_;
+
+  double external_work_ = 0, damping_loss_ = 0;
+  std::array<double, kStageCount> stage_s_{};
+  std::array<long, kStageCount> stage_calls_{};
+  Clock::time_point t0_;
+};
+
+}  // namespace mmpm
+
+#include "solver/stepper_impl.hpp"

@@ -1,0 +1,635 @@
+// Implementation of Stepper (included by stepper.hpp only).
+#pragma once
+
+namespace mmpm {
+
+template <int D, class Shape, class Real>
+Stepper<D, Shape, Real>::Stepper(const Scene& scene) : scene_(scene), plan_(plan_fields(scene)) {
+  for (const auto& m : scene.materials)
+    materials_.push_back(make_material(m, D, scene.simulation.plane));
+  boundaries_ = resolve_boundaries(scene);
+  boundary_reaction_.assign(boundaries_.size(), Vec3{0, 0, 0});
+  dt_ = stable_time_step(scene);
+  thickness_ = D == 2 ? Real(scene.simulation.thickness) : Real(1);
+  for (const auto& l : scene.loads) {
+    if (l.kind == LoadKind::gravity) {
+      has_gravity_ = true;
+      for (int d = 0; d < D; ++d) gravity_[d] += l.acceleration[d];
+    } else {
+      has_traction_ = true;
+      traction_ramp_end_ = std::max(traction_ramp_end_, l.ramp);
+    }
+  }
+  setup_grid();
+  setup_particles(make_particles(scene));
+  mm_.setup(scene, plan_, G_, mass_threshold_);
+  rigid_velocity_now_.assign(std::size_t(plan_.fields) * 3, 0.0);
+}
+
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::setup_grid() {
+  const auto& g = scene_.grid;
+  G_.fields = plan_.fields;
+  G_.nodes = 1;
+  for (int d = 0; d < D; ++d) {
+    G_.nodes_per_dim[d] = g.cells[d] + 1;
+    G_.h[d] = Real(g.cell[d]);
+    G_.origin[d] = Real(g.origin[d]);
+    G_.nodes *= std::size_t(g.cells[d] + 1);
+  }
+  const std::size_t n = G_.nodes * std::size_t(plan_.fields);
+  const char* axis = "xyz";
+  G_.m = gcols_.add_real("m", n);
+  for (int d = 0; d < D; ++d) {
+    G_.p[d] = gcols_.add_real(std::string("p") + axis[d], n);
+    G_.f[d] = gcols_.add_real(std::string("f") + axis[d], n);
+    GV_.vel[d] = gcols_.add_real(std::string("vel") + axis[d], n);
+    GV_.dvel[d] = gcols_.add_real(std::string("dvel") + axis[d], n);
+  }
+  if (plan_.multimaterial) {
+    G_.vol = gcols_.add_real("vol", n);
+    for (int d = 0; d < D; ++d) {
+      G_.mx[d] = gcols_.add_real(std::string("mx") + axis[d], n);
+      G_.g[d] = gcols_.add_real(std::string("g") + axis[d], n);
+      G_.fi[d] = gcols_.add_real(std::string("fi") + axis[d], n);
+    }
+  }
+  int T = g.tile > 0 ? g.tile : (D == 2 ? 8 : 4);
+  tiles_.setup(std::max(3, T), g.cells);
+}
+
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::setup_particles(const ParticleSeeds& seeds) {
+  const std::size_t n = seeds.x.size();
+  P_.n = n;
+  const char* axis = "xyz";
+  const bool finite = std::any_of(materials_.begin(), materials_.end(),
+                                  [](const MaterialModel& m) { return m.finite_strain(); });
+  const bool need_x0 = true;  // displacement output and the displacement separation method
+  for (int d = 0; d < D; ++d) P_.x[d] = pcols_.add_real(std::string("x") + axis[d], n);
+  for (int d = 0; d < D; ++d) P_.v[d] = pcols_.add_real(std::string("v") + axis[d], n);
+  P_.m = pcols_.add_real("m", n);
+  P_.V = pcols_.add_real("V", n);
+  for (int c = 0; c < NS; ++c) P_.s[c] = pcols_.add_real("s" + std::to_string(c), n);
+  for (int c = 0; c < D * D; ++c) P_.L[c] = pcols_.add_real("L" + std::to_string(c), n);
+  if (finite)
+    for (int c = 0; c < D * D; ++c) P_.F[c] = pcols_.add_real("F" + std::to_string(c), n);
+  if (need_x0)
+    for (int d = 0; d < D; ++d) P_.x0[d] = pcols_.add_real(std::string("x0") + axis[d], n);
+  if (scene_.grid.shape == ShapeKind::gimp)
+    for (int d = 0; d < D; ++d) P_.lp[d] = pcols_.add_real(std::string("lp") + axis[d], n);
+  if (has_traction_)
+    for (int d = 0; d < D; ++d) P_.fext[d] = pcols_.add_real(std::string("fext") + axis[d], n);
+  P_.mat = pcols_.add_byte("mat", n);
+  if (plan_.multimaterial) P_.field = pcols_.add_byte("field", n);
+  if (has_traction_) {
+    // Base traction force and load index travel with the particle as columns.
+    for (int d = 0; d < D; ++d) pcols_.add_real(std::string("fbase") + axis[d], n);
+    pcols_.add_byte("load", n);
+  }
+  pcols_.key.allocate(n, pcols_.next_slot++);
+  P_.key = pcols_.key.data();
+
+  double min_mass = std::numeric_limits<double>::max();
+  for (std::size_t p = 0; p < n; ++p) {
+    const auto& mat = materials_[std::size_t(seeds.material[p])];
+    for (int d = 0; d < D; ++d) {
+      P_.x[d][p] = Real(seeds.x[p][d]);
+      P_.x0[d][p] = Real(seeds.x[p][d]);
+      P_.v[d][p] = Real(seeds.v[p][d]);
+      if (P_.lp[d]) P_.lp[d][p] = Real(seeds.half_width[p][d]);
+    }
+    const double mass = mat.density * seeds.volume[p];
+    min_mass = std::min(min_mass, mass);
+    P_.m[p] = Real(mass);
+    P_.V[p] = Real(seeds.volume[p]);
+    if (P_.F[0])
+      for (int c = 0; c < D * D; ++c) P_.F[c][p] = (c % (D + 1)) == 0 ? Real(1) : Real(0);
+    P_.mat[p] = std::uint8_t(seeds.material[p]);
+    if (P_.field) P_.field[p] = std::uint8_t(plan_.field_of_material[std::size_t(seeds.material[p])]);
+    if (has_traction_) {
+      Real* base[3] = {pcols_.real("fbasex"), pcols_.real("fbasey"), D == 3 ? pcols_.real("fbasez") : nullptr};
+      for (int d = 0; d < D; ++d) base[d][p] = Real(seeds.traction_force[p][d]);
+      pcols_.bytes.back()[p] = std::uint8_t(seeds.load[p] < 0 ? 255 : seeds.load[p]);
+    }
+  }
+  // Fields lighter than this at a node are empty there (ALGORITHM §4.3).
+  mass_threshold_ = Real(1e-9 * min_mass);
+  // Check every particle's stencil fits the grid before anything runs.
+  const std::array<Real, 3> inv_h{Real(1) / G_.h[0], Real(1) / G_.h[1], Real(1) / G_.h[2]};
+  Stencil<D, Shape, Real> st;
+  for (std::size_t p = 0; p < n; ++p)
+    if (!st.build(P_, G_, inv_h, p))
+      throw InputError(located(scene_.source_file, 0, "grid",
+                               "particle " + std::to_string(p) +
+                                   " is too close to the grid edge for the '" + Shape::name +
+                                   "' shape function: enlarge the grid"));
+  const std::size_t nm = materials_.size();
+  if (nm > 1) material_particles_.resize(nm);
+  dirty_ = true;
+}
+
+template <int D, class Shape, class Real>
+std::uint32_t Stepper<D, Shape, Real>::key_of_position(std::size_t p) const {
+  std::array<int, 3> c{0, 0, 0};
+  for (int d = 0; d < D; ++d) c[d] = cell_of(P_.x[d][p], G_.origin[d], Real(1) / G_.h[d]);
+  return tiles_.key(c);
+}
+
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::sort_particles() {
+  const std::size_t n = P_.n;
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+  for (std::size_t p = 0; p < n; ++p) P_.key[p] = key_of_position(p);
+  counting_sort(P_.key, n, tiles_.key_count(), offsets_, perm_);
+  scratch_.resize(n);
+  for (auto& col : pcols_.reals) {
+    gather_permute(col.data(), scratch_.data(), perm_.data(), n);
+    std::memcpy(col.data(), scratch_.data(), n * sizeof(Real));
+  }
+  scratch_bytes_.resize(n);
+  for (auto& col : pcols_.bytes) {
+    gather_permute(col.data(), scratch_bytes_.data(), perm_.data(), n);
+    std::memcpy(col.data(), scratch_bytes_.data(), n);
+  }
+  scratch_keys_.resize(n);
+  gather_permute(P_.key, scratch_keys_.data(), perm_.data(), n);
+  std::memcpy(P_.key, scratch_keys_.data(), n * sizeof(std::uint32_t));
+  rebuild_ranges();
+  dirty_ = false;
+}
+
+// Tile ranges, color lists and per-material lists from the (sorted) keys.
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::rebuild_ranges() {
+  const std::size_t n = P_.n;
+  const std::uint32_t nt = tiles_.tile_count;
+  tile_begin_.assign(std::size_t(nt) + 1, 0);
+  for (std::size_t p = 0; p < n; ++p) ++tile_begin_[P_.key[p] / tiles_.keys_per_tile + 1];
+  for (std::uint32_t t = 0; t < nt; ++t) tile_begin_[t + 1] += tile_begin_[t];
+  for (auto& c : color_tiles_) c.clear();
+  for (std::uint32_t t = 0; t < nt; ++t)
+    if (tile_begin_[t + 1] > tile_begin_[t]) color_tiles_[std::size_t(tiles_.color(t))].push_back(t);
+  if (!material_particles_.empty()) {
+    for (auto& l : material_particles_) l.clear();
+    for (std::size_t p = 0; p < n; ++p) material_particles_[P_.mat[p]].push_back(std::uint32_t(p));
+  }
+}
+
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::zero_grid(bool mm) {
+  const std::size_t n = G_.nodes * std::size_t(G_.fields);
+  auto zero = [n](Real* a) {
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+    for (std::size_t i = 0; i < n; ++i) a[i] = Real(0);
+  };
+  zero(G_.m);
+  for (int d = 0; d < D; ++d) zero(G_.p[d]), zero(G_.f[d]);
+  if (mm) {
+    zero(G_.vol);
+    for (int d = 0; d < D; ++d) zero(G_.mx[d]), zero(G_.g[d]), zero(G_.fi[d]);
+  }
+}
+
+template <int D, class Shape, class Real>
+template <unsigned What>
+void Stepper<D, Shape, Real>::p2g(const char* label) {
+  P2GOptions opt;
+  opt.position_separation = plan_.position_separation;
+  opt.inv_thickness = 1.0 / double(thickness_);
+  std::size_t bad = SIZE_MAX;
+  for (const auto& tiles : color_tiles_) {
+    const std::size_t nt = tiles.size();
+#pragma omp parallel for schedule(dynamic, 1) reduction(min : bad) if (P_.n >= kParallelMin)
+    for (std::size_t k = 0; k < nt; ++k) {
+      const std::uint32_t t = tiles[k];
+      const std::size_t b = tile_begin_[t], e = tile_begin_[t + 1];
+      std::size_t r;
+      if (plan_.multimaterial) {
+        r = has_traction_ ? p2g_range<D, Shape, Real, What, true, true>(P_, G_, opt, b, e)
+                          : p2g_range<D, Shape, Real, What, true, false>(P_, G_, opt, b, e);
+      } else {
+        r = has_traction_ ? p2g_range<D, Shape, Real, What & ~unsigned(kMultimaterial), false, true>(P_, G_, opt, b, e)
+                          : p2g_range<D, Shape, Real, What & ~unsigned(kMultimaterial), false, false>(P_, G_, opt, b, e);
+      }
+      if (r != e) bad = std::min(bad, r);
+    }
+  }
+  if (bad != SIZE_MAX) fail_particle(label, bad, "its shape-function stencil left the grid");
+}
+
+template <int D, class Shape, class Real>
+template <unsigned What>
+void Stepper<D, Shape, Real>::g2p() {
+  G2PParams q;
+  q.dt = dt_;
+  q.flip = scene_.simulation.flip;
+  q.rigid = plan_.rigid.data();
+  q.rigid_velocity = reinterpret_cast<const double(*)[3]>(rigid_velocity_now_.data());
+  for (int d = 0; d < D; ++d) q.body_accel[d] = gravity_[d];
+  const KeyFn key_of{this};
+  const std::size_t n = P_.n, chunks = chunk_count(n);
+  std::vector<G2PRangeResult> res(chunks);
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+  for (std::size_t c = 0; c < chunks; ++c) {
+    const std::size_t b = c * kReduceChunk, e = std::min(n, b + kReduceChunk);
+    auto run = [&]<bool MF, bool TR, bool GR>() {
+      return g2p_range<D, Shape, Real, What, MF, TR, GR>(P_, G_, GV_, q, key_of, b, e);
+    };
+    if (plan_.multimaterial) {
+      if (has_traction_) res[c] = has_gravity_ ? run.template operator()<true, true, true>() : run.template operator()<true, true, false>();
+      else res[c] = has_gravity_ ? run.template operator()<true, false, true>() : run.template operator()<true, false, false>();
+    } else {
+      if (has_traction_) res[c] = has_gravity_ ? run.template operator()<false, true, true>() : run.template operator()<false, true, false>();
+      else res[c] = has_gravity_ ? run.template operator()<false, false, true>() : run.template operator()<false, false, false>();
+    }
+  }
+  for (const auto& r : res) {
+    if (r.bad != SIZE_MAX) fail_particle("g2p", r.bad, "non-finite velocity or stencil off the grid");
+    external_work_ += r.external_work;
+    if (r.moved_tile) dirty_ = true;
+  }
+}
+
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::constitutive() {
+  for (std::size_t mi = 0; mi < materials_.size(); ++mi) {
+    const MaterialModel& mat = materials_[mi];
+    const std::uint32_t* idx = nullptr;
+    std::size_t count = P_.n;
+    if (!material_particles_.empty()) {
+      idx = material_particles_[mi].data();
+      count = material_particles_[mi].size();
+    }
+    switch (mat.type) {
+      case MaterialType::isotropic: isotropic_update(P_, idx, count, mat.k, dt_); break;
+      case MaterialType::transverse: anisotropic_update(P_, idx, count, mat.k, dt_); break;
+      case MaterialType::neohookean: neohookean_update(P_, idx, count, mat.k, dt_); break;
+      case MaterialType::rigid: break;
+    }
+  }
+}
+
+// Non-finite or non-positive volumes mark an inverted or blown-up particle.
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::check_volumes() {
+  const std::size_t n = P_.n;
+  std::size_t bad = SIZE_MAX;
+#pragma omp parallel for schedule(static) reduction(min : bad) if (n >= kParallelMin)
+  for (std::size_t p = 0; p < n; ++p)
+    if (!(P_.V[p] > Real(0)) || !std::isfinite(P_.V[p]) || !std::isfinite(P_.s[0][p])) bad = std::min(bad, p);
+  if (bad != SIZE_MAX) fail_particle("constitutive", bad, "J <= 0 or a non-finite stress/volume");
+}
+
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::grid_update_stage() {
+  GridUpdateParams q;
+  q.dt = dt_;
+  q.damping = scene_.grid.damping;
+  q.mass_threshold = double(mass_threshold_);
+  for (int d = 0; d < D; ++d) q.body_accel[d] = gravity_[d];
+  q.rigid = plan_.rigid.data();
+  q.rigid_velocity = reinterpret_cast<const double(*)[3]>(rigid_velocity_now_.data());
+  q.has_interface_force = mm_.has_interface_forces();
+  damping_loss_ += grid_update(G_, GV_, q);
+}
+
+// Supports: the fixed components get the support's velocity; the momentum
+// this takes is the reaction force (what a load cell would read).
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::apply_boundaries(bool with_dvel) {
+  for (std::size_t b = 0; b < boundaries_.size(); ++b) {
+    const BoundaryNodes& bc = boundaries_[b];
+    const Vec3 vb = boundary_velocity(bc, time_, dt_);
+    Vec3 reaction{0, 0, 0};
+    for (int f = 0; f < G_.fields; ++f) {
+      if (plan_.rigid[std::size_t(f)]) continue;
+      const std::size_t o = std::size_t(f) * G_.nodes;
+      for (std::uint32_t node : bc.nodes) {
+        const std::size_t i = o + node;
+        const Real m = G_.m[i];
+        if (!(m > mass_threshold_)) continue;
+        for (int d = 0; d < D; ++d) {
+          if (!bc.fix[d]) continue;
+          const Real v_target = Real(vb[d]);
+          const Real change = v_target - GV_.vel[d][i];
+          reaction[d] += double(m) * double(change) / dt_;
+          external_work_ += double(m) * double(change) / dt_ * vb[d] * dt_;
+          GV_.vel[d][i] = v_target;
+          if (with_dvel) GV_.dvel[d][i] += change;
+          G_.p[d][i] = m * v_target;
+        }
+      }
+    }
+    boundary_reaction_[b] = reaction;
+  }
+}
+
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::finish_velocities(bool with_dvel) {
+  if (with_dvel) {
+    grid_velocities(G_, GV_, mass_threshold_);
+  } else {
+    const std::size_t total = G_.nodes * std::size_t(G_.fields);
+#pragma omp parallel for schedule(static) if (total >= kParallelMin)
+    for (std::size_t i = 0; i < total; ++i) {
+      const Real m = G_.m[i];
+      for (int d = 0; d < D; ++d) GV_.vel[d][i] = m > mass_threshold_ ? G_.p[d][i] / m : Real(0);
+    }
+  }
+  apply_boundaries(with_dvel);
+}
+
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::update_tractions() {
+  // Only while a ramp runs: the force is constant afterwards.
+  if (!has_traction_) return;
+  if (time_ > traction_ramp_end_ + dt_ && step_ > 1) return;
+  const std::size_t n = P_.n;
+  const std::uint8_t* load = pcols_.bytes.back().data();
+  Real* base[3] = {pcols_.real("fbasex"), pcols_.real("fbasey"), D == 3 ? pcols_.real("fbasez") : nullptr};
+  std::vector<Real> scale(scene_.loads.size() + 1, Real(0));
+  for (std::size_t l = 0; l < scene_.loads.size(); ++l) {
+    const double r = scene_.loads[l].ramp;
+    // Force at mid-step, so the impulse over the ramp is exact.
+    const double tm = time_ + 0.5 * dt_;
+    scale[l] = Real(r > 0 ? std::min(1.0, tm / r) : 1.0);
+  }
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+  for (std::size_t p = 0; p < n; ++p) {
+    const Real s = load[p] == 255 ? Real(0) : scale[load[p]];
+    for (int d = 0; d < D; ++d) P_.fext[d][p] = s * base[d][p];
+  }
+}
+
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::step() {
+  const Scheme scheme = scene_.simulation.scheme;
+  const bool mm = plan_.multimaterial;
+  for (int f = 0; f < plan_.fields; ++f) {
+    const int m = plan_.rigid_material[std::size_t(f)];
+    if (m < 0) continue;
+    const Vec3 v = rigid_velocity(scene_.materials[std::size_t(m)], time_ + dt_);
+    for (int d = 0; d < 3; ++d) rigid_velocity_now_[std::size_t(f) * 3 + std::size_t(d)] = v[d];
+  }
+  tic();
+  const int every = scene_.simulation.sort_every;
+  if (dirty_ || (every > 0 && step_ % every == 0)) sort_particles();
+  update_tractions();
+  toc(kStageSort);
+
+  tic();
+  zero_grid(mm);
+  if (scheme == Scheme::USF)
+    p2g<kMassMomentum | kMultimaterial>("p2g");
+  else
+    p2g<kMassMomentum | kForce | kMultimaterial>("p2g");
+  toc(kStageP2G);
+
+  if (mm) {
+    tic();
+    mm_.pass_a(G_, dt_, time_, step_);
+    toc(kStageMultimaterial);
+  }
+
+  if (scheme == Scheme::USF) {
+    // Stress first, from the velocities of the extrapolated momenta.
+    tic();
+    finish_velocities(false);
+    toc(kStageGrid);
+    tic();
+    g2p<kVelocityGradient>();
+    toc(kStageG2P);
+    tic();
+    constitutive();
+    check_volumes();
+    toc(kStageConstitutive);
+    tic();
+    p2g<kForce>("p2g");
+    toc(kStageP2G);
+  }
+
+  tic();
+  grid_update_stage();
+  toc(kStageGrid);
+  if (mm) {
+    tic();
+    mm_.pass_b(G_);
+    toc(kStageMultimaterial);
+  }
+  tic();
+  finish_velocities(true);
+  toc(kStageGrid);
+
+  if (scheme == Scheme::USL) {
+    tic();
+    g2p<kUpdateMotion | kVelocityGradient>();
+    toc(kStageG2P);
+  } else if (scheme == Scheme::USF) {
+    tic();
+    g2p<kUpdateMotion>();
+    toc(kStageG2P);
+  } else {  // MUSL: the gradient from the momenta of the updated particles
+    tic();
+    g2p<kUpdateMotion>();
+    toc(kStageG2P);
+    tic();
+    const std::size_t n = G_.nodes * std::size_t(G_.fields);
+    for (int d = 0; d < D; ++d) std::fill(G_.p[d], G_.p[d] + n, Real(0));
+    p2g<kMomentumOnly>("p2g");
+    toc(kStageP2G);
+    if (mm) {
+      tic();
+      mm_.pass_b(G_);
+      toc(kStageMultimaterial);
+    }
+    tic();
+    finish_velocities(false);
+    toc(kStageGrid);
+    tic();
+    g2p<kVelocityGradient>();
+    toc(kStageG2P);
+  }
+  if (scheme != Scheme::USF) {
+    tic();
+    constitutive();
+    check_volumes();
+    toc(kStageConstitutive);
+  }
+  time_ += dt_;
+  ++step_;
+}
+
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::fail_particle(const char* stage, std::size_t p, const std::string& why) const {
+  std::ostringstream os;
+  os << "unstable: stage " << stage << ", step " << step_ << ", particle " << p << " (material '"
+     << materials_[P_.mat[p]].name << "', x = [";
+  for (int d = 0; d < D; ++d) os << (d ? ", " : "") << double(P_.x[d][p]);
+  os << "]): " << why;
+  throw SimulationError(os.str());
+}
+
+template <int D, class Shape, class Real>
+Energies Stepper<D, Shape, Real>::energies() const {
+  Energies e;
+  const std::size_t n = P_.n;
+  auto parts = deterministic_sum<2>(n, [&](std::size_t b, std::size_t end, std::array<double, 2>& acc) {
+    for (std::size_t p = b; p < end; ++p) {
+      double v2 = 0;
+      for (int d = 0; d < D; ++d) v2 += double(P_.v[d][p]) * double(P_.v[d][p]);
+      acc[0] += 0.5 * double(P_.m[p]) * v2;
+      const MaterialModel& mat = materials_[P_.mat[p]];
+      if (mat.rigid()) continue;
+      if (mat.finite_strain()) {
+        double F[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+        for (int i = 0; i < D; ++i)
+          for (int j = 0; j < D; ++j) F[i * 3 + j] = double(P_.F[i * D + j][p]);
+        const double J = F[0] * (F[4] * F[8] - F[5] * F[7]) - F[1] * (F[3] * F[8] - F[5] * F[6]) +
+                         F[2] * (F[3] * F[7] - F[4] * F[6]);
+        double I1 = 0;
+        for (int c = 0; c < 9; ++c) I1 += F[c] * F[c];
+        const double lnJ = std::log(J), V0 = double(P_.m[p]) / mat.density;
+        acc[1] += V0 * (0.5 * mat.k.mu * (I1 - 3 - 2 * lnJ) + 0.5 * mat.k.lambda * lnJ * lnJ);
+      } else {
+        double s[6] = {0, 0, 0, 0, 0, 0};
+        if constexpr (D == 2) {
+          s[0] = double(P_.s[0][p]), s[1] = double(P_.s[1][p]), s[5] = double(P_.s[2][p]);
+          s[2] = double(P_.s[3][p]);
+        } else {
+          for (int c = 0; c < 6; ++c) s[c] = double(P_.s[c][p]);
+        }
+        double u = 0;
+        for (int i = 0; i < 6; ++i)
+          for (int j = 0; j < 6; ++j) u += s[i] * mat.compliance[i][j] * s[j];
+        acc[1] += 0.5 * u * double(P_.V[p]);
+      }
+    }
+  });
+  e.kinetic = parts[0];
+  e.strain = parts[1];
+  e.interface = mm_.interface_energy();
+  e.external_work = external_work_;
+  e.damping = damping_loss_;
+  // Kinetic energy of the grid velocity field (after the last update).
+  const std::size_t total = G_.nodes * std::size_t(G_.fields);
+  auto grid_ke = deterministic_sum<1>(total, [&](std::size_t b, std::size_t end, std::array<double, 1>& acc) {
+    for (std::size_t i = b; i < end; ++i) {
+      double v2 = 0;
+      for (int d = 0; d < D; ++d) v2 += double(GV_.vel[d][i]) * double(GV_.vel[d][i]);
+      acc[0] += 0.5 * double(G_.m[i]) * v2;
+    }
+  });
+  e.kinetic_unresolved = step_ > 0 ? e.kinetic - grid_ke[0] : 0.0;
+  return e;
+}
+
+template <int D, class Shape, class Real>
+std::vector<Reaction> Stepper<D, Shape, Real>::reactions() const {
+  std::vector<Reaction> out;
+  for (std::size_t b = 0; b < boundaries_.size(); ++b) out.push_back({boundaries_[b].label, boundary_reaction_[b]});
+  for (int f = 0; f < plan_.fields; ++f) {
+    const int m = plan_.rigid_material[std::size_t(f)];
+    if (m >= 0) out.push_back({"rigid:" + scene_.materials[std::size_t(m)].name, mm_.rigid_reaction(f)});
+  }
+  return out;
+}
+
+template <int D, class Shape, class Real>
+io::ParticleField Stepper<D, Shape, Real>::particle_field(const std::string& name) const {
+  const std::size_t n = P_.n;
+  io::ParticleField out{name, 1, {}};
+  auto vec = [&](const std::array<Real*, D>& a, const std::array<Real*, D>* minus) {
+    out.components = D;
+    out.values.resize(n * D);
+    for (std::size_t p = 0; p < n; ++p)
+      for (int d = 0; d < D; ++d)
+        out.values[p * D + std::size_t(d)] = double(a[d][p]) - (minus ? double((*minus)[d][p]) : 0.0);
+  };
+  if (name == "position") {
+    vec(P_.x, nullptr);
+  } else if (name == "displacement") {
+    vec(P_.x, &P_.x0);
+  } else if (name == "velocity") {
+    vec(P_.v, nullptr);
+  } else if (name == "stress") {
+    out.components = NS;
+    out.values.resize(n * NS);
+    for (std::size_t p = 0; p < n; ++p)
+      for (int c = 0; c < NS; ++c) out.values[p * NS + std::size_t(c)] = double(P_.s[c][p]);
+  } else if (name == "material" || name == "mass" || name == "volume") {
+    out.values.resize(n);
+    for (std::size_t p = 0; p < n; ++p)
+      out.values[p] = name == "material" ? double(P_.mat[p]) : (name == "mass" ? double(P_.m[p]) : double(P_.V[p]));
+  } else {
+    throw InputError("output field '" + name + "' is unknown (position, displacement, velocity, stress, material, mass, volume)");
+  }
+  return out;
+}
+
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::set_particle_field(const std::string& name, const std::vector<double>& values) {
+  if (name != "velocity" || values.size() != P_.n * D)
+    throw std::invalid_argument("set_particle_field: only 'velocity' with D values per particle");
+  for (std::size_t p = 0; p < P_.n; ++p)
+    for (int d = 0; d < D; ++d) P_.v[d][p] = Real(values[p * D + std::size_t(d)]);
+}
+
+template <int D, class Shape, class Real>
+io::Snapshot Stepper<D, Shape, Real>::snapshot(const std::vector<std::string>& fields) const {
+  io::Snapshot s;
+  s.step = step_;
+  s.time = time_;
+  s.dimension = D;
+  s.count = P_.n;
+  s.position = particle_field("position").values;
+  for (const auto& f : fields)
+    if (f != "position") s.fields.push_back(particle_field(f));
+  return s;
+}
+
+template <int D, class Shape, class Real>
+std::vector<io::Blob> Stepper<D, Shape, Real>::save_state() const {
+  std::vector<io::Blob> out;
+  const std::size_t n = P_.n;
+  for (std::size_t c = 0; c < pcols_.reals.size(); ++c)
+    out.push_back(io::make_blob("p." + pcols_.real_names[c],
+                                std::vector<Real>(pcols_.reals[c].data(), pcols_.reals[c].data() + n)));
+  for (std::size_t c = 0; c < pcols_.bytes.size(); ++c)
+    out.push_back(io::make_blob("b." + pcols_.byte_names[c],
+                                std::vector<std::uint8_t>(pcols_.bytes[c].data(), pcols_.bytes[c].data() + n)));
+  out.push_back(io::make_blob("key", std::vector<std::uint32_t>(P_.key, P_.key + n)));
+  out.push_back(io::make_scalar_blob("step", step_));
+  out.push_back(io::make_scalar_blob("time", time_));
+  out.push_back(io::make_scalar_blob("external_work", external_work_));
+  out.push_back(io::make_scalar_blob("damping_loss", damping_loss_));
+  out.push_back(io::make_scalar_blob("dirty", int(dirty_)));
+  out.push_back(io::make_scalar_blob("interface_energy", mm_.interface_energy()));
+  return out;
+}
+
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::load_state(const std::vector<io::Blob>& blobs) {
+  const std::size_t n = P_.n;
+  auto load_column = [&](const std::string& name, auto* dst) {
+    using T = std::remove_pointer_t<decltype(dst)>;
+    std::vector<T> v;
+    io::read_blob(io::find_blob(blobs, name), v);
+    if (v.size() != n) throw std::runtime_error("checkpoint does not match the scene: column " + name);
+    std::memcpy(dst, v.data(), n * sizeof(T));
+  };
+  for (std::size_t c = 0; c < pcols_.reals.size(); ++c)
+    load_column("p." + pcols_.real_names[c], const_cast<Real*>(pcols_.reals[c].data()));
+  for (std::size_t c = 0; c < pcols_.bytes.size(); ++c)
+    load_column("b." + pcols_.byte_names[c], const_cast<std::uint8_t*>(pcols_.bytes[c].data()));
+  load_column("key", P_.key);
+  step_ = io::read_scalar_blob<long>(io::find_blob(blobs, "step"));
+  time_ = io::read_scalar_blob<double>(io::find_blob(blobs, "time"));
+  external_work_ = io::read_scalar_blob<double>(io::find_blob(blobs, "external_work"));
+  damping_loss_ = io::read_scalar_blob<double>(io::find_blob(blobs, "damping_loss"));
+  dirty_ = io::read_scalar_blob<int>(io::find_blob(blobs, "dirty")) != 0;
+  mm_.set_interface_energy(io::read_scalar_blob<double>(io::find_blob(blobs, "interface_energy")));
+  rebuild_ranges();
+}
+
+}  // namespace mmpm

@@ -1,0 +1,40 @@
+// Owning storage for particle and grid columns (flat SoA, one staggered
+// array per component; ARCHITECTURE "Data"). Columns are registered by name
+// so sorting, checkpoints and output can walk them generically.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "model/staggered_array.hpp"
+
+namespace mmpm {
+
+template <class Real>
+struct ColumnSet {
+  std::vector<std::string> real_names;
+  std::vector<StaggeredArray<Real>> reals;
+  std::vector<std::string> byte_names;
+  std::vector<StaggeredArray<std::uint8_t>> bytes;
+  StaggeredArray<std::uint32_t> key;  // binning key (particles only)
+  int next_slot = 0;
+
+  Real* add_real(const std::string& name, std::size_t n) {
+    real_names.push_back(name);
+    reals.emplace_back(n, next_slot++);
+    return reals.back().data();
+  }
+  std::uint8_t* add_byte(const std::string& name, std::size_t n) {
+    byte_names.push_back(name);
+    bytes.emplace_back(n, next_slot++);
+    return bytes.back().data();
+  }
+  Real* real(const std::string& name) {
+    for (std::size_t i = 0; i < real_names.size(); ++i)
+      if (real_names[i] == name) return reals[i].data();
+    return nullptr;
+  }
+};
+
+}  // namespace mmpm
