@@ -53,9 +53,12 @@ G2PRangeResult g2p_range(const ParticleView<D, Real>& P, const GridView<D, Real>
       if (MultiField && q.rigid && q.rigid[field]) {  // prescribed motion (§7)
         for (int d = 0; d < D; ++d) {
           P.v[d][p] = Real(q.rigid_velocity[field][d]);
-          P.x[d][p] += dt * P.v[d][p];
+          if (P.x_next[0])
+            P.x_next[d][p] = P.x[d][p] + dt * P.v[d][p];
+          else
+            P.x[d][p] += dt * P.v[d][p];
         }
-        if (key_of.tile(p) != key_of.tile_of_key(P.key[p])) r.moved_tile = true;
+        if (!P.x_next[0] && key_of.tile(p) != key_of.tile_of_key(P.key[p])) r.moved_tile = true;
         continue;
       }
     }
@@ -80,7 +83,10 @@ G2PRangeResult g2p_range(const ParticleView<D, Real>& P, const GridView<D, Real>
         const Real vold = P.v[d][p];
         const Real vnew = flip * (vold + dv[d]) + pic * vn[d];
         P.v[d][p] = vnew;
-        P.x[d][p] += dt * vn[d];
+        if (P.x_next[0])
+          P.x_next[d][p] = P.x[d][p] + dt * vn[d];
+        else
+          P.x[d][p] += dt * vn[d];
         finite = finite && std::isfinite(vnew);
         const double vmid = 0.5 * (double(vold) + double(vnew));
         if constexpr (Traction) work += double(P.fext[d][p]) * vmid;
@@ -88,7 +94,7 @@ G2PRangeResult g2p_range(const ParticleView<D, Real>& P, const GridView<D, Real>
       }
       if constexpr (Traction || Gravity) r.external_work += work * q.dt;
       if (!finite && r.bad == SIZE_MAX) r.bad = p;
-      if (key_of.tile(p) != key_of.tile_of_key(P.key[p])) r.moved_tile = true;
+      if (!P.x_next[0] && key_of.tile(p) != key_of.tile_of_key(P.key[p])) r.moved_tile = true;
     }
     if constexpr ((What & kVelocityGradient) != 0)
       for (int c = 0; c < D * D; ++c) P.L[c][p] = L[c];

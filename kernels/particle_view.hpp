@@ -28,6 +28,10 @@ struct ParticleView {
   std::uint8_t* field = nullptr;  // material velocity field (only with > 1 field)
   std::uint8_t* mat = nullptr;    // material index
   std::uint32_t* key = nullptr;   // binning key (tile-major cell index) at the last sort
+  // MUSL only: G2P writes the updated positions here, so the second transfer
+  // and the velocity gradient still use the shape functions of the step's
+  // start (Sulsky's MUSL); the stepper copies them into x afterwards.
+  std::array<Real*, D> x_next{};
 };
 
 }  // namespace mmpm

@@ -9,6 +9,7 @@
 #include <system_error>
 
 #include "io/atomic_file.hpp"
+#include "io/h5.hpp"
 #include "io/xdmf.hpp"
 
 namespace mmpm::io {
@@ -207,15 +208,15 @@ void drop_unused_vertices(h5::Group& root, const std::vector<XdmfSnapshot>& snap
 
 }  // namespace
 
-RunWriter::RunWriter(fs::path dir, h5::File file) : dir_(std::move(dir)), file_(std::move(file)) {}
+RunWriter::RunWriter(fs::path dir, std::unique_ptr<h5::File> file)
+    : dir_(std::move(dir)), file_(std::move(file)) {}
 
-RunWriter::RunWriter(const fs::path& dir) : dir_(dir), file_([&] {
-  fs::create_directories(dir);
-  fs::remove(dir / "run.h5");
-  fs::remove(dir / "run.xdmf");
-  return h5::File::create(dir / "run.h5.partial");
-}()) {
-  file_.root().set_int_attribute("mmpm_layout", 1);
+RunWriter::RunWriter(const fs::path& dir) : dir_(dir) {
+  fs::create_directories(dir_);
+  fs::remove(h5_path());
+  fs::remove(xdmf_path());
+  file_ = std::make_unique<h5::File>(h5::File::create(partial_path()));
+  file_->root().set_int_attribute("mmpm_layout", 1);
 }
 
 RunWriter RunWriter::reopen(const fs::path& dir, long last_step) {
@@ -223,8 +224,9 @@ RunWriter RunWriter::reopen(const fs::path& dir, long last_step) {
   if (!fs::exists(partial)) {
     throw std::runtime_error("cannot restart: " + partial.string() + " does not exist");
   }
-  RunWriter writer(dir, h5::File::open(partial, h5::File::Mode::read_write));
-  h5::Group root = writer.file_.root();
+  RunWriter writer(
+      dir, std::make_unique<h5::File>(h5::File::open(partial, h5::File::Mode::read_write)));
+  h5::Group root = writer.file_->root();
   for (const char* group_name : {particles_group, xdmf_group}) {
     if (!root.contains(group_name)) continue;
     h5::Group group = root.open_group(group_name);
@@ -233,36 +235,51 @@ RunWriter RunWriter::reopen(const fs::path& dir, long last_step) {
     }
   }
   remove_if_present(root, series_group);
-  writer.file_.flush();
-  fs::remove(dir / "run.h5");
-  fs::remove(dir / "run.xdmf");
+  writer.file_->flush();
+  fs::remove(writer.h5_path());
+  fs::remove(writer.xdmf_path());
   return writer;
 }
 
-RunWriter::~RunWriter() {
-  if (!file_.valid()) return;
+RunWriter::RunWriter(RunWriter&&) noexcept = default;
+
+RunWriter& RunWriter::operator=(RunWriter&& other) noexcept {
+  if (this != &other) {
+    close_quietly();
+    dir_ = std::move(other.dir_);
+    file_ = std::move(other.file_);
+  }
+  return *this;
+}
+
+RunWriter::~RunWriter() { close_quietly(); }
+
+void RunWriter::close_quietly() noexcept {
+  if (!is_open()) return;
   try {
-    file_.close();
+    file_->close();
   } catch (...) {
-    // Nothing to report to from a destructor; the partial stays for restart.
+    // Nothing to report to from here; the partial stays for restart.
   }
 }
 
+bool RunWriter::is_open() const { return file_ != nullptr && file_->valid(); }
+
 void RunWriter::require_open(const char* operation) const {
-  if (!file_.valid()) {
+  if (!is_open()) {
     throw std::logic_error(std::string("RunWriter::") + operation + " after finish() or abandon()");
   }
 }
 
 void RunWriter::set_attribute(const std::string& name, const std::string& value) {
   require_open("set_attribute");
-  file_.root().set_string_attribute(name, value);
+  file_->root().set_string_attribute(name, value);
 }
 
 void RunWriter::write_snapshot(const Snapshot& snapshot) {
   require_open("write_snapshot");
   check_snapshot(snapshot);
-  h5::Group root = file_.root();
+  h5::Group root = file_->root();
   const std::string name = step_name(snapshot.step);
   remove_snapshot(root, name);
   try {
@@ -276,7 +293,7 @@ void RunWriter::write_snapshot(const Snapshot& snapshot) {
     }
     throw;
   }
-  file_.flush();
+  file_->flush();
 }
 
 void RunWriter::write_series(const std::vector<std::string>& names,
@@ -300,26 +317,26 @@ void RunWriter::write_series(const std::vector<std::string>& names,
     }
     list += (i == 0 ? "" : ",") + names[i];
   }
-  h5::Group root = file_.root();
+  h5::Group root = file_->root();
   remove_if_present(root, series_group);
   h5::Group series = root.create_group(series_group);
   series.set_string_attribute("columns", list);
   for (std::size_t i = 0; i < names.size(); ++i) {
     series.write_doubles(names[i], columns[i], {static_cast<hsize_t>(columns[i].size())});
   }
-  file_.flush();
+  file_->flush();
 }
 
 void RunWriter::finish() {
   require_open("finish");
   std::string document;
   {
-    h5::Group root = file_.root();
+    h5::Group root = file_->root();
     const std::vector<XdmfSnapshot> snapshots = describe(root);
     drop_unused_vertices(root, snapshots);
     document = xdmf_document("run.h5", snapshots);
   }  // every handle into the file is closed before the file itself
-  file_.close();
+  file_->close();
   // The data must be on disk before the name that promises a complete result.
   fsync_file(partial_path());
   fs::rename(partial_path(), h5_path());
@@ -330,12 +347,8 @@ void RunWriter::finish() {
 void RunWriter::abandon() {
   // A closed file means finish() or abandon() already ran (or this writer
   // was moved from): there is no partial of ours to delete.
-  if (!file_.valid()) return;
-  try {
-    file_.close();
-  } catch (...) {
-    // The file is being discarded; a close failure changes nothing.
-  }
+  if (!is_open()) return;
+  close_quietly();  // the file is being discarded: a close failure changes nothing
   std::error_code ignored;
   fs::remove(partial_path(), ignored);
 }

@@ -21,12 +21,15 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
-#include "io/h5.hpp"
-
 namespace mmpm::io {
+
+namespace h5 {
+class File;  // io/h5.hpp; kept out of this header so users need no HDF5 headers
+}
 
 struct ParticleField {
   std::string name;  // letters, digits, '_', '.', '-'; not "position"
@@ -56,8 +59,8 @@ class RunWriter {
   // Throws std::runtime_error if there is no partial file or it is unreadable.
   static RunWriter reopen(const std::filesystem::path& dir, long last_step);
 
-  RunWriter(RunWriter&&) noexcept = default;
-  RunWriter& operator=(RunWriter&&) noexcept = default;
+  RunWriter(RunWriter&&) noexcept;
+  RunWriter& operator=(RunWriter&&) noexcept;  // the replaced writer is closed as by ~RunWriter
   RunWriter(const RunWriter&) = delete;
   RunWriter& operator=(const RunWriter&) = delete;
 
@@ -94,11 +97,13 @@ class RunWriter {
   std::filesystem::path xdmf_path() const { return dir_ / "run.xdmf"; }
 
  private:
-  RunWriter(std::filesystem::path dir, h5::File file);
+  RunWriter(std::filesystem::path dir, std::unique_ptr<h5::File> file);
+  bool is_open() const;
   void require_open(const char* operation) const;
+  void close_quietly() noexcept;
 
   std::filesystem::path dir_;
-  h5::File file_;  // closed once finish() or abandon() has run
+  std::unique_ptr<h5::File> file_;  // null or closed once finish() or abandon() has run
 };
 
 }  // namespace mmpm::io

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "kernels/multimaterial.hpp"
+#include "scene/error.hpp"
 #include "solver/field_plan.hpp"
 #include "solver/simulation.hpp"
 
@@ -16,7 +17,8 @@ namespace mmpm {
 template <int D, class Real>
 class MultimaterialStage {
  public:
-  void setup(const Scene& scene, const FieldPlan& plan, const GridView<D, Real>& grid, Real mass_threshold) {
+  void setup(const Scene& scene, const FieldPlan& plan, const GridView<D, Real>& grid, Real mass_threshold,
+             double dt) {
     enabled_ = plan.multimaterial;
     fields_ = plan.fields;
     stats_.reset(plan.fields);
@@ -56,6 +58,9 @@ class MultimaterialStage {
     // Contact and interfaces ignore a material whose nodal mass is a sliver
     // (ALGORITHM §4.3): 1e-6 of the lightest particle, well above round-off.
     cfg_.mass_threshold = mass_threshold * Real(1000);
+    cfg_.dt = Real(dt);
+    if (const char* why = validate_multimaterial(grid, cfg_))
+      throw InputError(scene.source_file + ": multimaterial setup: " + why);
   }
 
   bool has_interface_forces() const { return enabled_ && has_interface_; }

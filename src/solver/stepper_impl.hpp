@@ -22,7 +22,7 @@ Stepper<D, Shape, Real>::Stepper(const Scene& scene) : scene_(scene), plan_(plan
   }
   setup_grid();
   setup_particles(make_particles(scene));
-  mm_.setup(scene, plan_, G_, mass_threshold_);
+  mm_.setup(scene, plan_, G_, mass_threshold_, dt_);
   rigid_velocity_now_.assign(std::size_t(plan_.fields) * 3, 0.0);
 }
 
@@ -314,14 +314,18 @@ void Stepper<D, Shape, Real>::apply_boundaries(bool with_dvel) {
           const Real v_target = Real(vb[d]);
           const Real change = v_target - GV_.vel[d][i];
           reaction[d] += double(m) * double(change) / dt_;
-          external_work_ += double(m) * double(change) / dt_ * vb[d] * dt_;
           GV_.vel[d][i] = v_target;
           if (with_dvel) GV_.dvel[d][i] += change;
           G_.p[d][i] = m * v_target;
         }
       }
     }
-    boundary_reaction_[b] = reaction;
+    // Only the application after the momentum update is the support's
+    // impulse for the step (USF and MUSL also enforce it on other transfers).
+    if (with_dvel) {
+      boundary_reaction_[b] = reaction;
+      for (int d = 0; d < D; ++d) external_work_ += reaction[d] * vb[d] * dt_;
+    }
   }
 }
 
@@ -431,6 +435,10 @@ void Stepper<D, Shape, Real>::step() {
     toc(kStageG2P);
   } else {  // MUSL: the gradient from the momenta of the updated particles
     tic();
+    for (int d = 0; d < D; ++d) {
+      x_next_[d].resize(P_.n);
+      P_.x_next[d] = x_next_[d].data();
+    }
     g2p<kUpdateMotion>();
     toc(kStageG2P);
     tic();
@@ -448,6 +456,16 @@ void Stepper<D, Shape, Real>::step() {
     toc(kStageGrid);
     tic();
     g2p<kVelocityGradient>();
+    // Positions move only now, after both transfers used the step's start.
+    const std::size_t np = P_.n;
+    bool moved = false;
+#pragma omp parallel for schedule(static) reduction(|| : moved) if (np >= kParallelMin)
+    for (std::size_t p = 0; p < np; ++p) {
+      for (int d = 0; d < D; ++d) P_.x[d][p] = P_.x_next[d][p];
+      moved = moved || tile_of_position(p) != P_.key[p] / tiles_.keys_per_tile;
+    }
+    if (moved) dirty_ = true;
+    for (int d = 0; d < D; ++d) P_.x_next[d] = nullptr;
     toc(kStageG2P);
   }
   if (scheme != Scheme::USF) {

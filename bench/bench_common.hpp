@@ -1,0 +1,388 @@
+// Shared pieces of the benchmarks: particle blocks and grids built straight
+// from the kernel views (no scene, no Stepper), the binning the solver does
+// before its colored scatter, the two comparison scatters (serial, atomic),
+// and the counters every benchmark reports.
+//
+// Benchmark names are "family/key:value/key:value/..." so bench/table.py can
+// read them back (Google Benchmark appends "/real_time" or "/manual_time").
+#pragma once
+
+#include <benchmark/benchmark.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <functional>
+#include <memory>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "kernels/binning.hpp"
+#include "kernels/g2p.hpp"
+#include "kernels/grid_update.hpp"
+#include "kernels/grid_view.hpp"
+#include "kernels/p2g.hpp"
+#include "kernels/particle_view.hpp"
+#include "kernels/reduce.hpp"
+#include "kernels/shape.hpp"
+#include "kernels/weights.hpp"
+#include "model/staggered_array.hpp"
+
+namespace mmpm::bench {
+
+// Registration entry points, called in this order by bench_main.cpp.
+void register_p2g();
+void register_g2p();
+void register_multimaterial();
+void register_sort();
+void register_step();
+
+template <class Real>
+inline const char* real_name() {
+  return sizeof(Real) == 8 ? "double" : "float";
+}
+
+// The solver's default tile edges (solver/stepper_impl.hpp setup_grid).
+template <int D>
+inline constexpr int kDefaultTile = D == 2 ? 8 : 4;
+
+// ---------------------------------------------------------------- counters
+// ns_per_particle = (time per iteration) / particles, as a rate counter: the
+// value particles * 1e-9 per iteration, divided by the (real or manual) time
+// and inverted, reads directly in nanoseconds.
+inline void set_ns_per_item(benchmark::State& state, const char* name, double items) {
+  state.counters[name] = benchmark::Counter(
+      items * 1e-9, benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+}
+inline void set_ns_per_particle(benchmark::State& state, double particles) {
+  set_ns_per_item(state, "ns_per_particle", particles);
+  state.counters["particles"] = particles;
+}
+// Throughput of a quantity counted per iteration (e.g. bytes, flops), scaled
+// by `unit` (1e-9: giga per second).
+inline void set_rate(benchmark::State& state, const char* name, double per_iteration,
+                     double unit = 1e-9) {
+  state.counters[name] =
+      benchmark::Counter(per_iteration * unit, benchmark::Counter::kIsIterationInvariantRate);
+}
+
+// Scale of every benchmark's minimum time (bench_main: --quick sets 0.25).
+inline double& time_scale() {
+  static double scale = 1.0;
+  return scale;
+}
+inline double min_time(double seconds) { return seconds * time_scale(); }
+
+// Thread count for the OpenMP kernels of one benchmark.
+inline void use_threads(int threads) { omp_set_num_threads(threads); }
+
+// ---------------------------------------------------------------- particles
+template <int D, class Real>
+struct ParticleSet {
+  std::vector<StaggeredArray<Real>> reals;  // every real column, permuted together
+  std::vector<StaggeredArray<std::uint8_t>> bytes;
+  StaggeredArray<std::uint32_t> key;
+  ParticleView<D, Real> P;
+  int slot = 0;
+
+  ParticleSet() {
+    reals.reserve(64);
+    bytes.reserve(4);
+  }
+  ParticleSet(const ParticleSet&) = delete;
+  ParticleSet& operator=(const ParticleSet&) = delete;
+  Real* add_real(std::size_t n) {
+    reals.emplace_back(n, slot++);
+    return reals.back().data();
+  }
+  std::uint8_t* add_byte(std::size_t n) {
+    bytes.emplace_back(n, slot++);
+    return bytes.back().data();
+  }
+  std::size_t size() const { return P.n; }
+  // Bytes a particle occupies over all its columns.
+  std::size_t bytes_per_particle() const {
+    return reals.size() * sizeof(Real) + bytes.size() + sizeof(std::uint32_t);
+  }
+};
+
+// A block of particles on a regular lattice: `ppc` per direction in every
+// cell of [lo, hi) (cells of size 1, grid origin 0), generated x fastest.
+struct BlockSpec {
+  std::array<int, 3> lo{2, 2, 2}, hi{4, 4, 4};
+  int ppc = 2;
+  bool gimp = false;          // allocate the uGIMP half-widths (the solver does for gimp only)
+  bool multifield = false;    // allocate the field index
+  double interface_x = 1e30;  // particles with x > interface_x belong to material/field 1
+};
+
+template <int D, class Real>
+void make_block(ParticleSet<D, Real>& S, const BlockSpec& b) {
+  constexpr int NS = kStressComponents<D>;
+  std::size_t n = 1;
+  for (int d = 0; d < D; ++d) n *= std::size_t(b.hi[d] - b.lo[d]) * std::size_t(b.ppc);
+  ParticleView<D, Real>& P = S.P;
+  P.n = n;
+  // Same column set as the Stepper (solver/stepper_impl.hpp setup_particles).
+  for (int d = 0; d < D; ++d) P.x[d] = S.add_real(n);
+  for (int d = 0; d < D; ++d) P.v[d] = S.add_real(n);
+  P.m = S.add_real(n);
+  P.V = S.add_real(n);
+  for (int c = 0; c < NS; ++c) P.s[c] = S.add_real(n);
+  for (int c = 0; c < D * D; ++c) P.L[c] = S.add_real(n);
+  for (int d = 0; d < D; ++d) P.x0[d] = S.add_real(n);
+  if (b.gimp)
+    for (int d = 0; d < D; ++d) P.lp[d] = S.add_real(n);
+  P.mat = S.add_byte(n);
+  if (b.multifield) P.field = S.add_byte(n);
+  S.key.allocate(n, S.slot++);
+  P.key = S.key.data();
+
+  const double spacing = 1.0 / b.ppc;
+  const double vol = std::pow(spacing, D);
+  std::array<int, 3> count{1, 1, 1};
+  for (int d = 0; d < D; ++d) count[d] = (b.hi[d] - b.lo[d]) * b.ppc;
+  std::size_t p = 0;
+  for (int k = 0; k < (D == 3 ? count[2] : 1); ++k)
+    for (int j = 0; j < count[1]; ++j)
+      for (int i = 0; i < count[0]; ++i, ++p) {
+        const int idx[3] = {i, j, k};
+        double x[3];
+        for (int d = 0; d < D; ++d) x[d] = b.lo[d] + (idx[d] + 0.5) * spacing;
+        const int material = x[0] > b.interface_x ? 1 : 0;
+        for (int d = 0; d < D; ++d) {
+          P.x[d][p] = Real(x[d]);
+          P.x0[d][p] = Real(x[d]);
+          // A smooth, non-trivial velocity field (values matter only for realism).
+          P.v[d][p] = Real(0.1 * (1.0 + 0.3 * std::sin(0.05 * x[(d + 1) % D] + d)));
+          if (b.gimp) P.lp[d][p] = Real(0.5 * spacing);
+        }
+        P.m[p] = Real(1.2e-3 * vol);
+        P.V[p] = Real(vol);
+        for (int c = 0; c < NS; ++c) P.s[c][p] = Real(1.0 + 0.1 * c + 0.01 * std::sin(0.1 * x[0]));
+        for (int c = 0; c < D * D; ++c) P.L[c][p] = Real(1e-3 * (1 + c) * std::cos(0.07 * x[1]));
+        P.mat[p] = std::uint8_t(material);
+        if (P.field) P.field[p] = std::uint8_t(material);
+      }
+}
+
+// ---------------------------------------------------------------- grid
+template <int D, class Real>
+struct GridSet {
+  std::vector<StaggeredArray<Real>> cols;
+  GridView<D, Real> G;
+  GridVelocity<D, Real> V;
+  int slot = 32;  // staggered slots distinct from the particle columns
+
+  GridSet() { cols.reserve(64); }
+  GridSet(const GridSet&) = delete;
+  GridSet& operator=(const GridSet&) = delete;
+  Real* add(std::size_t n) {
+    cols.emplace_back(n, slot++);
+    return cols.back().data();
+  }
+  // cells per direction; `mm` adds vol, mx, g, fi (the multimaterial fields);
+  // `velocities` adds the G2P velocity arrays.
+  void setup(const std::array<int, 3>& cells, int fields, bool mm, bool velocities) {
+    G.fields = fields;
+    G.nodes = 1;
+    for (int d = 0; d < D; ++d) {
+      G.nodes_per_dim[d] = cells[d] + 1;
+      G.h[d] = Real(1);
+      G.origin[d] = Real(0);
+      G.nodes *= std::size_t(cells[d] + 1);
+    }
+    const std::size_t n = G.nodes * std::size_t(fields);
+    G.m = add(n);
+    for (int d = 0; d < D; ++d) G.p[d] = add(n), G.f[d] = add(n);
+    if (mm) {
+      G.vol = add(n);
+      for (int d = 0; d < D; ++d) G.mx[d] = add(n), G.g[d] = add(n), G.fi[d] = add(n);
+    }
+    if (velocities)
+      for (int d = 0; d < D; ++d) V.vel[d] = add(n), V.dvel[d] = add(n);
+  }
+  std::size_t size() const { return G.nodes * std::size_t(G.fields); }
+  void zero() {
+    for (auto& c : cols) std::memset(static_cast<void*>(c.data()), 0, c.size() * sizeof(Real));
+  }
+};
+
+// ---------------------------------------------------------------- binning
+// The solver's sort (Stepper::sort_particles + rebuild_ranges): keys by tile,
+// stable counting sort, every column permuted, tile ranges and color lists.
+template <int D, class Real>
+struct Binning {
+  TileLayout<D> tiles;
+  std::vector<std::uint32_t> offsets, perm, tile_begin;
+  std::array<std::vector<std::uint32_t>, 8> color_tiles;
+  std::vector<Real> scratch;
+  std::vector<std::uint8_t> scratch_bytes;
+  std::vector<std::uint32_t> scratch_keys;
+
+  void setup(int tile_edge, const GridView<D, Real>& G) {
+    std::array<int, 3> cells{1, 1, 1};
+    for (int d = 0; d < D; ++d) cells[d] = G.nodes_per_dim[d] - 1;
+    tiles.setup(tile_edge, cells);
+  }
+  std::uint32_t key_of(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
+                       std::size_t p) const {
+    std::array<int, 3> c{0, 0, 0};
+    for (int d = 0; d < D; ++d) c[d] = cell_of(P.x[d][p], G.origin[d], Real(1) / G.h[d]);
+    return tiles.key(c);
+  }
+  void compute_keys(ParticleSet<D, Real>& S, const GridView<D, Real>& G) const {
+    const std::size_t n = S.P.n;
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+    for (std::size_t p = 0; p < n; ++p) S.P.key[p] = key_of(S.P, G, p);
+  }
+  void permute(ParticleSet<D, Real>& S) {
+    const std::size_t n = S.P.n;
+    scratch.resize(n);
+    for (auto& col : S.reals) {
+      gather_permute(col.data(), scratch.data(), perm.data(), n);
+      std::memcpy(col.data(), scratch.data(), n * sizeof(Real));
+    }
+    scratch_bytes.resize(n);
+    for (auto& col : S.bytes) {
+      gather_permute(col.data(), scratch_bytes.data(), perm.data(), n);
+      std::memcpy(col.data(), scratch_bytes.data(), n);
+    }
+    scratch_keys.resize(n);
+    gather_permute(S.P.key, scratch_keys.data(), perm.data(), n);
+    std::memcpy(S.P.key, scratch_keys.data(), n * sizeof(std::uint32_t));
+  }
+  void rebuild_ranges(const ParticleSet<D, Real>& S) {
+    const std::size_t n = S.P.n;
+    const std::uint32_t nt = tiles.tile_count;
+    tile_begin.assign(std::size_t(nt) + 1, 0);
+    for (std::size_t p = 0; p < n; ++p) ++tile_begin[S.P.key[p] / tiles.keys_per_tile + 1];
+    for (std::uint32_t t = 0; t < nt; ++t) tile_begin[t + 1] += tile_begin[t];
+    for (auto& c : color_tiles) c.clear();
+    for (std::uint32_t t = 0; t < nt; ++t)
+      if (tile_begin[t + 1] > tile_begin[t]) color_tiles[std::size_t(tiles.color(t))].push_back(t);
+  }
+  void sort(ParticleSet<D, Real>& S, const GridView<D, Real>& G) {
+    compute_keys(S, G);
+    counting_sort(S.P.key, S.P.n, tiles.key_count(), offsets, perm);
+    permute(S);
+    rebuild_ranges(S);
+  }
+};
+
+// ---------------------------------------------------------------- scatters
+// (a) The solver's colored scatter (Stepper::p2g): colors in turn, the tiles
+// of a color in parallel, each tile added straight into the grid.
+template <int D, class Shape, class Real, unsigned What, bool MultiField, bool Traction>
+std::size_t p2g_colored(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
+                        const P2GOptions& opt, const Binning<D, Real>& B) {
+  std::size_t bad = SIZE_MAX;
+  for (const auto& tiles : B.color_tiles) {
+    const std::size_t nt = tiles.size();
+#pragma omp parallel for schedule(dynamic, 1) reduction(min : bad) if (P.n >= kParallelMin)
+    for (std::size_t k = 0; k < nt; ++k) {
+      const std::uint32_t t = tiles[k];
+      const std::size_t b = B.tile_begin[t], e = B.tile_begin[t + 1];
+      const std::size_t r = p2g_range<D, Shape, Real, What, MultiField, Traction>(P, G, opt, b, e);
+      if (r != e) bad = std::min(bad, r);
+    }
+  }
+  return bad;
+}
+
+// (b) Serial scatter: one thread, particle order.
+template <int D, class Shape, class Real, unsigned What>
+std::size_t p2g_serial(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
+                       const P2GOptions& opt) {
+  const std::size_t r = p2g_range<D, Shape, Real, What, false, false>(P, G, opt, 0, P.n);
+  return r == P.n ? SIZE_MAX : r;
+}
+
+// (c) Atomic scatter: particles split statically across the threads, every
+// grid addition an `omp atomic` (the same sums as p2g_range with
+// kMassMomentum | kForce, one field, no traction).
+template <int D, class Shape, class Real>
+std::size_t p2g_atomic(const ParticleView<D, Real>& P, const GridView<D, Real>& G) {
+  constexpr int NS = kStressComponents<D>;
+  const std::array<Real, 3> inv_h{Real(1) / G.h[0], Real(1) / G.h[1], Real(1) / G.h[2]};
+  const std::size_t n = P.n;
+  std::size_t bad = SIZE_MAX;
+#pragma omp parallel reduction(min : bad)
+  {
+    Stencil<D, Shape, Real> st;
+#pragma omp for schedule(static)
+    for (std::size_t p = 0; p < n; ++p) {
+      if (!st.build(P, G, inv_h, p)) {
+        bad = std::min(bad, p);
+        continue;
+      }
+      const Real mp = P.m[p];
+      Real mv[D], vs[NS];
+      for (int d = 0; d < D; ++d) mv[d] = mp * P.v[d][p];
+      for (int c = 0; c < NS; ++c) vs[c] = P.V[p] * P.s[c][p];
+      for (int k = 0; k < st.count; ++k) {
+        const std::size_t i = st.base + st.node[k];
+        const Real w = st.w[k];
+        const auto& gk = st.g[k];
+        Real f[D];
+        if constexpr (D == 2) {
+          f[0] = -(vs[0] * gk[0] + vs[2] * gk[1]);
+          f[1] = -(vs[2] * gk[0] + vs[1] * gk[1]);
+        } else {
+          f[0] = -(vs[0] * gk[0] + vs[5] * gk[1] + vs[4] * gk[2]);
+          f[1] = -(vs[5] * gk[0] + vs[1] * gk[1] + vs[3] * gk[2]);
+          f[2] = -(vs[4] * gk[0] + vs[3] * gk[1] + vs[2] * gk[2]);
+        }
+        const Real dm = w * mp;
+#pragma omp atomic
+        G.m[i] += dm;
+        for (int d = 0; d < D; ++d) {
+          const Real dp = w * mv[d];
+#pragma omp atomic
+          G.p[d][i] += dp;
+#pragma omp atomic
+          G.f[d][i] += f[d];
+        }
+      }
+    }
+  }
+  return bad;
+}
+
+// Floating-point operations of the kMassMomentum | kForce scatter per stencil
+// node (one field, no traction): m 2, p 2D, f D * (2D) (D products, D-1 sums,
+// one subtraction into the grid). Stencil construction is not counted.
+template <int D>
+inline constexpr int kP2GFlopsPerNode = 2 + 2 * D + D * 2 * D;
+
+// Particle bytes the scatter streams in (x, v, m, V, stress, lp for gimp).
+template <int D, class Shape, class Real>
+inline constexpr std::size_t kP2GParticleBytes =
+    sizeof(Real) * (2 * D + 2 + kStressComponents<D> + (std::is_same_v<Shape, GimpShape> ? D : 0));
+
+// ---------------------------------------------------------------- fixture cache
+// Benchmarks of one family share their (large) fixture across the repeated
+// calls Google Benchmark makes; only one fixture is alive at a time.
+inline std::function<void()>& fixture_release() {
+  static std::function<void()> release;
+  return release;
+}
+template <class Fixture, class Key, class Make>
+Fixture& cached_fixture(const Key& key, Make&& make) {
+  static std::unique_ptr<Fixture> fx;
+  static Key fx_key{};
+  if (!fx || !(fx_key == key)) {
+    if (fixture_release()) fixture_release()();
+    fx = make();
+    fx_key = key;
+    fixture_release() = [] { fx.reset(); };
+  }
+  return *fx;
+}
+
+}  // namespace mmpm::bench

@@ -1,0 +1,177 @@
+// G2P (velocity FLIP/PIC, position, velocity gradient, tile-change test) per
+// shape function, and the isotropic constitutive update, per dimension,
+// precision and thread count. Same particle blocks as the P2G benchmarks.
+#include "bench/bench_common.hpp"
+#include "kernels/constitutive.hpp"
+
+namespace mmpm::bench {
+namespace {
+
+template <int D>
+BlockSpec g2p_block(bool gimp) {
+  BlockSpec b;
+  b.ppc = 2;
+  b.gimp = gimp;
+  for (int d = 0; d < D; ++d) {
+    b.lo[d] = 2;
+    b.hi[d] = D == 2 ? 252 : 34;
+  }
+  return b;
+}
+template <int D>
+std::array<int, 3> g2p_cells() {
+  return D == 2 ? std::array<int, 3>{254, 254, 1} : std::array<int, 3>{36, 36, 36};
+}
+
+// The tile-change test the Stepper's KeyFn does after moving a particle.
+template <int D, class Real>
+struct TileKeyFn {
+  const Binning<D, Real>* bins;
+  const ParticleView<D, Real>* P;
+  const GridView<D, Real>* G;
+  std::uint32_t tile(std::size_t p) const {
+    return bins->key_of(*P, *G, p) / bins->tiles.keys_per_tile;
+  }
+  std::uint32_t tile_of_key(std::uint32_t k) const { return k / bins->tiles.keys_per_tile; }
+};
+
+template <int D, class Shape, class Real>
+struct G2PFixture {
+  ParticleSet<D, Real> S;
+  GridSet<D, Real> grid;
+  Binning<D, Real> bins;
+};
+
+template <int D, class Shape, class Real>
+G2PFixture<D, Shape, Real>& g2p_fixture() {
+  using F = G2PFixture<D, Shape, Real>;
+  return cached_fixture<F>(0, [] {
+    auto fx = std::make_unique<F>();
+    make_block<D, Real>(fx->S, g2p_block<D>(std::is_same_v<Shape, GimpShape>));
+    fx->grid.setup(g2p_cells<D>(), 1, false, true);
+    fx->bins.setup(kDefaultTile<D>, fx->grid.G);
+    fx->bins.sort(fx->S, fx->grid.G);
+    // Small smooth grid velocities: particles drift by ~1e-6 cell per iteration.
+    const GridView<D, Real>& G = fx->grid.G;
+    for (std::size_t i = 0; i < G.nodes; ++i) {
+      const auto x = G.position(i);
+      for (int d = 0; d < D; ++d) {
+        fx->grid.V.vel[d][i] = Real(1e-3 * std::sin(0.05 * x[0] + 0.03 * x[1] + d));
+        fx->grid.V.dvel[d][i] = Real(1e-6 * std::cos(0.02 * x[0] + d));
+      }
+    }
+    return fx;
+  });
+}
+
+template <int D, class Shape, class Real>
+void bm_g2p(benchmark::State& state, int threads) {
+  use_threads(threads);
+  auto& fx = g2p_fixture<D, Shape, Real>();
+  const ParticleView<D, Real>& P = fx.S.P;
+  const GridView<D, Real>& G = fx.grid.G;
+  const GridVelocity<D, Real>& V = fx.grid.V;
+  constexpr unsigned What = kUpdateMotion | kVelocityGradient;
+  G2PParams q;
+  q.dt = 1e-3;
+  q.flip = 0.99;
+  const TileKeyFn<D, Real> key_of{&fx.bins, &P, &G};
+  const std::size_t n = P.n, chunks = chunk_count(n);
+  std::vector<G2PRangeResult> res(chunks);
+  for (auto _ : state) {
+    // As Stepper::g2p: fixed chunks, static schedule.
+#pragma omp parallel for schedule(static) if (n >= kParallelMin)
+    for (std::size_t c = 0; c < chunks; ++c) {
+      const std::size_t b = c * kReduceChunk, e = std::min(n, b + kReduceChunk);
+      res[c] = g2p_range<D, Shape, Real, What, false, false, false>(P, G, V, q, key_of, b, e);
+    }
+    benchmark::DoNotOptimize(res.data());
+    benchmark::ClobberMemory();
+  }
+  for (const auto& r : res)
+    if (r.bad != SIZE_MAX) {
+      state.SkipWithError("G2P: stencil off the grid or non-finite velocity");
+      return;
+    }
+  set_ns_per_particle(state, double(n));
+  // Particle bytes: read x, v, key (+ lp), write x, v, L.
+  const double bytes = double(sizeof(Real)) * (4 * D + D * D + (std::is_same_v<Shape, GimpShape> ? D : 0)) + 4.0;
+  set_rate(state, "particle_GBps", double(n) * bytes);
+  set_rate(state, "Gnode_reads_per_s", double(n) * Stencil<D, Shape, Real>::count);
+  state.counters["threads"] = threads;
+}
+
+template <int D, class Real>
+struct ConstitutiveFixture {
+  ParticleSet<D, Real> S;
+};
+
+template <int D, class Real>
+void bm_constitutive(benchmark::State& state, int threads) {
+  use_threads(threads);
+  using F = ConstitutiveFixture<D, Real>;
+  auto& fx = cached_fixture<F>(0, [] {
+    auto f = std::make_unique<F>();
+    make_block<D, Real>(f->S, g2p_block<D>(false));
+    return f;
+  });
+  const ParticleView<D, Real>& P = fx.S.P;
+  ElasticKernelConstants c;
+  const double E = 2400, nu = 0.33;
+  c.lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
+  c.mu = E / (2 * (1 + nu));
+  c.density = 1.2e-3;
+  c.plane_stress = false;
+  const double dt = 1e-4;
+  for (auto _ : state) {
+    isotropic_update<D, Real>(P, nullptr, P.n, c, dt);
+    benchmark::DoNotOptimize(P.s[0]);
+    benchmark::ClobberMemory();
+  }
+  if (!std::isfinite(double(P.s[0][0])) || !(P.V[0] > 0)) {
+    state.SkipWithError("constitutive: non-finite stress or volume");
+    return;
+  }
+  constexpr int NS = kStressComponents<D>;
+  set_ns_per_particle(state, double(P.n));
+  // Read L, s, V; write s, V.
+  set_rate(state, "particle_GBps", double(P.n) * double(sizeof(Real)) * (D * D + 2 * NS + 2));
+  state.counters["threads"] = threads;
+}
+
+template <int D, class Shape, class Real>
+void register_g2p_case() {
+  for (int threads : {1, 2}) {
+    const std::string name = "g2p/dim:" + std::to_string(D) + "/shape:" + Shape::name +
+                             "/real:" + real_name<Real>() + "/threads:" + std::to_string(threads);
+    benchmark::RegisterBenchmark(name.c_str(), [threads](benchmark::State& st) {
+      bm_g2p<D, Shape, Real>(st, threads);
+    })->UseRealTime()->MinTime(min_time(0.15))->Unit(benchmark::kMillisecond);
+  }
+}
+
+template <int D, class Real>
+void register_dim_real() {
+  register_g2p_case<D, LinearShape, Real>();
+  register_g2p_case<D, GimpShape, Real>();
+  register_g2p_case<D, BSpline2Shape, Real>();
+  register_g2p_case<D, BSpline3Shape, Real>();
+  for (int threads : {1, 2}) {
+    const std::string name = "constitutive/dim:" + std::to_string(D) + "/law:isotropic/real:" +
+                             real_name<Real>() + "/threads:" + std::to_string(threads);
+    benchmark::RegisterBenchmark(name.c_str(), [threads](benchmark::State& st) {
+      bm_constitutive<D, Real>(st, threads);
+    })->UseRealTime()->MinTime(min_time(0.15))->Unit(benchmark::kMillisecond);
+  }
+}
+
+}  // namespace
+
+void register_g2p() {
+  register_dim_real<2, double>();
+  register_dim_real<2, float>();
+  register_dim_real<3, double>();
+  register_dim_real<3, float>();
+}
+
+}  // namespace mmpm::bench

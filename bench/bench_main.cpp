@@ -1,0 +1,35 @@
+// mmpm_bench: registers the benchmark families in a fixed order and runs them.
+// bench/run passes --benchmark_format=json --benchmark_out=bench/results.json
+// and the context (git commit, load average) with --benchmark_context.
+#include <benchmark/benchmark.h>
+#include <omp.h>
+
+#include <cstring>
+#include <vector>
+
+#include "bench/bench_common.hpp"
+
+int main(int argc, char** argv) {
+  // --quick: a quarter of every minimum time (for a fast look; bench/run --quick).
+  std::vector<char*> args;
+  for (int i = 0; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--quick") == 0)
+      mmpm::bench::time_scale() = 0.25;
+    else
+      args.push_back(argv[i]);
+  }
+  argc = int(args.size());
+  args.push_back(nullptr);
+  argv = args.data();
+  mmpm::bench::register_p2g();
+  mmpm::bench::register_g2p();
+  mmpm::bench::register_multimaterial();
+  mmpm::bench::register_sort();
+  mmpm::bench::register_step();
+  benchmark::Initialize(&argc, argv);
+  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
+  benchmark::AddCustomContext("omp_max_threads", std::to_string(omp_get_max_threads()));
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

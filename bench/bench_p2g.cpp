@@ -1,0 +1,172 @@
+// P2G: the three scatter strategies side by side (ARCHITECTURE "Parallel
+// scatter without races") for every shape function, 2D and 3D, double and
+// float, 1 and 2 threads; and the tile edge of the colored scatter.
+//
+// Problem: a block of particles filling most of the grid, 2 per cell and
+// direction: 2D 250x250 cells in a 254x254 grid (250 000 particles), 3D
+// 32^3 cells in a 36^3 grid (262 144 particles). What is scattered is the
+// solver's single-material USL transfer: mass, momentum, internal force.
+// Every strategy reads the same particle arrays, sorted by tile key as the
+// solver keeps them (sorting is measured on its own in bench_sort.cpp).
+// The grid is zeroed once per run, not per iteration (zeroing is O(nodes)
+// and appears in the whole-step numbers); a check at the end compares the
+// grid's total mass with iterations x particle mass, so a strategy that
+// loses additions is reported as an error.
+#include "bench/bench_common.hpp"
+
+namespace mmpm::bench {
+namespace {
+
+enum class Strategy { colored, serial, atomic };
+
+const char* strategy_name(Strategy s) {
+  switch (s) {
+    case Strategy::colored: return "colored";
+    case Strategy::serial: return "serial";
+    case Strategy::atomic: return "atomic";
+  }
+  return "?";
+}
+
+template <int D>
+BlockSpec p2g_block(bool gimp) {
+  BlockSpec b;
+  b.ppc = 2;
+  b.gimp = gimp;
+  for (int d = 0; d < D; ++d) {
+    b.lo[d] = 2;
+    b.hi[d] = D == 2 ? 252 : 34;
+  }
+  return b;
+}
+template <int D>
+std::array<int, 3> p2g_cells() {
+  return D == 2 ? std::array<int, 3>{254, 254, 1} : std::array<int, 3>{36, 36, 36};
+}
+
+template <int D, class Shape, class Real>
+struct P2GFixture {
+  ParticleSet<D, Real> S;
+  GridSet<D, Real> grid;
+  Binning<D, Real> bins;
+  double total_mass = 0;
+};
+
+template <int D, class Shape, class Real>
+P2GFixture<D, Shape, Real>& p2g_fixture(int tile) {
+  using F = P2GFixture<D, Shape, Real>;
+  return cached_fixture<F>(tile, [tile] {
+    auto fx = std::make_unique<F>();
+    make_block<D, Real>(fx->S, p2g_block<D>(std::is_same_v<Shape, GimpShape>));
+    fx->grid.setup(p2g_cells<D>(), 1, false, false);
+    fx->bins.setup(tile, fx->grid.G);
+    fx->bins.sort(fx->S, fx->grid.G);
+    for (std::size_t p = 0; p < fx->S.P.n; ++p) fx->total_mass += double(fx->S.P.m[p]);
+    return fx;
+  });
+}
+
+template <int D, class Shape, class Real>
+void bm_p2g(benchmark::State& state, Strategy strategy, int tile, int threads) {
+  use_threads(threads);
+  auto& fx = p2g_fixture<D, Shape, Real>(tile);
+  const ParticleView<D, Real>& P = fx.S.P;
+  const GridView<D, Real>& G = fx.grid.G;
+  constexpr unsigned What = kMassMomentum | kForce;
+  const P2GOptions opt;
+  fx.grid.zero();
+  std::size_t bad = SIZE_MAX;
+  for (auto _ : state) {
+    switch (strategy) {
+      case Strategy::colored:
+        bad = p2g_colored<D, Shape, Real, What, false, false>(P, G, opt, fx.bins);
+        break;
+      case Strategy::serial:
+        bad = p2g_serial<D, Shape, Real, What>(P, G, opt);
+        break;
+      case Strategy::atomic:
+        bad = p2g_atomic<D, Shape, Real>(P, G);
+        break;
+    }
+    benchmark::DoNotOptimize(bad);
+    benchmark::DoNotOptimize(G.m);
+    benchmark::ClobberMemory();
+  }
+  if (bad != SIZE_MAX) {
+    state.SkipWithError("a stencil left the grid");
+    return;
+  }
+  double grid_mass = 0;
+  for (std::size_t i = 0; i < G.nodes; ++i) grid_mass += double(G.m[i]);
+  const double expect = double(state.iterations()) * fx.total_mass;
+  const double tol = sizeof(Real) == 8 ? 1e-9 : 1e-3;
+  if (std::abs(grid_mass - expect) > tol * expect) {
+    state.SkipWithError("grid mass differs from iterations x particle mass");
+    return;
+  }
+  const double n = double(P.n);
+  constexpr int nodes = Stencil<D, Shape, Real>::count;
+  set_ns_per_particle(state, n);
+  set_rate(state, "Gnode_updates_per_s", n * nodes);
+  set_rate(state, "Gflops", n * nodes * kP2GFlopsPerNode<D>);
+  set_rate(state, "particle_GBps", n * double(kP2GParticleBytes<D, Shape, Real>));
+  state.counters["tile"] = tile;
+  state.counters["threads"] = threads;
+}
+
+template <int D, class Shape, class Real>
+void register_case() {
+  const std::string base = "p2g/dim:" + std::to_string(D) + "/shape:" + Shape::name +
+                           "/real:" + real_name<Real>() + "/strategy:";
+  auto add = [&](Strategy s, int tile, int threads) {
+    std::string name = base + strategy_name(s);
+    if (s == Strategy::colored) name += "/tile:" + std::to_string(tile);
+    name += "/threads:" + std::to_string(threads);
+    benchmark::RegisterBenchmark(name.c_str(), [s, tile, threads](benchmark::State& st) {
+      bm_p2g<D, Shape, Real>(st, s, tile, threads);
+    })->UseRealTime()->MinTime(min_time(0.15))->Unit(benchmark::kMillisecond);
+  };
+  const int T = kDefaultTile<D>;
+  add(Strategy::serial, T, 1);
+  add(Strategy::atomic, T, 1);
+  add(Strategy::atomic, T, 2);
+  add(Strategy::colored, T, 1);
+  add(Strategy::colored, T, 2);
+}
+
+// Tile edge sweep of the colored scatter (the solver's default is 8 in 2D, 4 in 3D).
+template <int D, class Shape, class Real>
+void register_tiles() {
+  for (int tile : {3, 4, 8, 16})
+    for (int threads : {1, 2}) {
+      const std::string name = "p2g_tile/dim:" + std::to_string(D) + "/shape:" + Shape::name +
+                               "/real:" + real_name<Real>() + "/strategy:colored/tile:" +
+                               std::to_string(tile) + "/threads:" + std::to_string(threads);
+      benchmark::RegisterBenchmark(name.c_str(), [tile, threads](benchmark::State& st) {
+        bm_p2g<D, Shape, Real>(st, Strategy::colored, tile, threads);
+      })->UseRealTime()->MinTime(min_time(0.15))->Unit(benchmark::kMillisecond);
+    }
+}
+
+template <int D, class Real>
+void register_shapes() {
+  register_case<D, LinearShape, Real>();
+  register_case<D, GimpShape, Real>();
+  register_case<D, BSpline2Shape, Real>();
+  register_case<D, BSpline3Shape, Real>();
+}
+
+}  // namespace
+
+void register_p2g() {
+  register_shapes<2, double>();
+  register_shapes<2, float>();
+  register_shapes<3, double>();
+  register_shapes<3, float>();
+  register_tiles<2, GimpShape, double>();
+  register_tiles<2, BSpline3Shape, double>();
+  register_tiles<3, GimpShape, double>();
+  register_tiles<3, BSpline3Shape, double>();
+}
+
+}  // namespace mmpm::bench

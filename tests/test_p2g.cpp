@@ -1,0 +1,458 @@
+// Particle-to-grid transfer (kernels/p2g.hpp) with the binning and coloring
+// of kernels/binning.hpp, on random particle sets in 2D and 3D, several shape
+// functions, double and float.
+//
+//  - Conservation: total grid mass = total particle mass, total grid momentum
+//    = total particle momentum, sum of nodal forces = sum of the traction
+//    forces (the internal forces -V sigma.G sum to zero because the gradients
+//    of a partition of unity do), nodal domains sum to the particle areas,
+//    the mass-weighted displacements to sum m (x - x0). Tolerance: relative
+//    to the sum of magnitudes, 1e-12 in double, 2e-5 in float.
+//  - The colored tile scatter as the solver runs it (counting_sort by the
+//    TileLayout key, colors in order, the tiles of one color in parallel on 2
+//    threads, schedule(dynamic)) is bitwise equal to the same scatter on 1
+//    thread and to a plain serial loop of p2g_range over the tiles in color
+//    order. It equals a serial p2g_range over all particles in sorted order
+//    and one in the original (unsorted) order to 1e-12 relative (double;
+//    float 1e-4), per array, relative to the array's largest magnitude.
+//    (Not bitwise to the sorted-order scatter: a node at a tile corner gets
+//    its contributions tile by tile in color order there, in tile-index order
+//    here, and floating-point addition is not associative — e.g. the tiles
+//    (0,1) [color 2] and (1,2) [color 1] share nodes; the sorted order adds
+//    (0,1) first, the colored order (1,2) first. Thread-count independence
+//    only needs the fixed color order, which is what is checked bitwise.)
+//  - Tiles of one color never touch a common node (checked node by node, so
+//    a coloring bug fails deterministically rather than by a lucky race).
+// Resolution: 2D grid 37 x 29 cells, 6000 particles; 3D 13 x 11 x 9 cells,
+// 4000 particles; cells of unequal size; tile edges 3 (the minimum) and 8.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <map>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "kernels/binning.hpp"
+#include "kernels/grid_view.hpp"
+#include "kernels/p2g.hpp"
+#include "kernels/particle_view.hpp"
+#include "kernels/shape.hpp"
+#include "kernels/weights.hpp"
+
+namespace {
+
+using namespace mmpm;
+
+template <int Dim, class S, class R>
+struct Cfg {
+  static constexpr int D = Dim;
+  using Shape = S;
+  using Real = R;
+};
+
+constexpr unsigned kAll = kMassMomentum | kForce | kMultimaterial;
+
+// Owning particle arrays (SoA) and their view.
+template <int D, class Real>
+struct Particles {
+  static constexpr int NS = kStressComponents<D>;
+  std::size_t n = 0;
+  std::array<std::vector<Real>, D> x, v, x0, lp, fext;
+  std::vector<Real> m, V;
+  std::array<std::vector<Real>, NS> s;
+  std::vector<std::uint8_t> field;
+  std::vector<std::uint32_t> key;
+
+  ParticleView<D, Real> view(bool gimp) {
+    ParticleView<D, Real> P;
+    P.n = n;
+    for (int d = 0; d < D; ++d) {
+      P.x[d] = x[d].data();
+      P.v[d] = v[d].data();
+      P.x0[d] = x0[d].data();
+      P.fext[d] = fext[d].data();
+      P.lp[d] = gimp ? lp[d].data() : nullptr;
+    }
+    P.m = m.data();
+    P.V = V.data();
+    for (int c = 0; c < NS; ++c) P.s[c] = s[c].data();
+    P.field = field.data();
+    P.key = key.data();
+    return P;
+  }
+
+  // The particles reordered: out[i] = this[perm[i]] (what the solver's sort does).
+  Particles permuted(const std::vector<std::uint32_t>& perm) const {
+    Particles o = *this;
+    auto apply = [&](const auto& in, auto& out) {
+      for (std::size_t i = 0; i < n; ++i) out[i] = in[perm[i]];
+    };
+    for (int d = 0; d < D; ++d) {
+      apply(x[d], o.x[d]);
+      apply(v[d], o.v[d]);
+      apply(x0[d], o.x0[d]);
+      apply(lp[d], o.lp[d]);
+      apply(fext[d], o.fext[d]);
+    }
+    apply(m, o.m);
+    apply(V, o.V);
+    for (int c = 0; c < NS; ++c) apply(s[c], o.s[c]);
+    apply(field, o.field);
+    apply(key, o.key);
+    return o;
+  }
+};
+
+// Owning grid arrays (fields x nodes) and their view.
+template <int D, class Real>
+struct Grid {
+  GridView<D, Real> G;
+  std::vector<std::vector<Real>> arrays;  // m, p[D], f[D], mx[D], vol, g[D]
+  std::array<int, 3> cells{1, 1, 1};
+
+  Grid(const std::array<int, 3>& c, int fields) : cells(c) {
+    const double h[3] = {0.5, 0.4, 0.6}, o[3] = {-1.0, 2.0, 0.5};
+    G.nodes = 1;
+    for (int d = 0; d < D; ++d) {
+      G.nodes_per_dim[d] = c[d] + 1;
+      G.h[d] = Real(h[d]);
+      G.origin[d] = Real(o[d]);
+      G.nodes *= std::size_t(c[d] + 1);
+    }
+    G.fields = fields;
+    const std::size_t total = G.nodes * std::size_t(fields);
+    arrays.assign(std::size_t(2 + 4 * D), std::vector<Real>(total, Real(0)));
+    std::size_t k = 0;
+    G.m = arrays[k++].data();
+    for (int d = 0; d < D; ++d) G.p[d] = arrays[k++].data();
+    for (int d = 0; d < D; ++d) G.f[d] = arrays[k++].data();
+    for (int d = 0; d < D; ++d) G.mx[d] = arrays[k++].data();
+    G.vol = arrays[k++].data();
+    for (int d = 0; d < D; ++d) G.g[d] = arrays[k++].data();
+  }
+  Grid(const Grid&) = delete;
+
+  double sum(const Real* a) const {
+    double s = 0;
+    for (std::size_t i = 0; i < G.nodes * std::size_t(G.fields); ++i) s += double(a[i]);
+    return s;
+  }
+  double sum_field(const Real* a, int f) const {
+    double s = 0;
+    for (std::size_t i = 0; i < G.nodes; ++i) s += double(a[G.at(f, i)]);
+    return s;
+  }
+};
+
+template <int D>
+std::array<int, 3> grid_cells() {
+  return D == 2 ? std::array<int, 3>{37, 29, 1} : std::array<int, 3>{13, 11, 9};
+}
+
+// Random particles at least 2 cells inside the grid (bspline3 needs that), in
+// 2 material fields, with random velocities, stresses, tractions, uGIMP half-widths.
+template <int D, class Real>
+Particles<D, Real> random_particles(const GridView<D, Real>& G, const std::array<int, 3>& cells,
+                                    std::size_t n, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  auto in = [&](double a, double b) { return a + (b - a) * U(rng); };
+  Particles<D, Real> p;
+  p.n = n;
+  for (int d = 0; d < D; ++d) {
+    for (auto* a : {&p.x[d], &p.v[d], &p.x0[d], &p.lp[d], &p.fext[d]}) a->resize(n);
+  }
+  p.m.resize(n);
+  p.V.resize(n);
+  for (auto& c : p.s) c.resize(n);
+  p.field.resize(n);
+  p.key.assign(n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (int d = 0; d < D; ++d) {
+      const double lo = double(G.origin[d]) + 2.05 * double(G.h[d]);
+      const double hi = double(G.origin[d]) + (cells[d] - 2.05) * double(G.h[d]);
+      p.x[d][i] = Real(in(lo, hi));
+      p.x0[d][i] = Real(double(p.x[d][i]) - in(-0.2, 0.2));
+      p.v[d][i] = Real(in(-1, 1));
+      p.lp[d][i] = Real(in(0.1, 0.5));
+      p.fext[d][i] = Real(in(-0.3, 0.3));
+    }
+    p.m[i] = Real(in(0.5, 2.0));
+    p.V[i] = Real(in(0.01, 0.03));
+    for (auto& c : p.s) c[i] = Real(in(-5, 5));
+    p.field[i] = std::uint8_t(U(rng) < 0.5 ? 0 : 1);
+  }
+  return p;
+}
+
+// The solver's binning: keys from the cell of every particle, stable counting sort.
+template <int D, class Real>
+std::vector<std::uint32_t> sort_by_tile(Particles<D, Real>& p, const GridView<D, Real>& G,
+                                        const TileLayout<D>& tiles) {
+  for (std::size_t i = 0; i < p.n; ++i) {
+    std::array<int, 3> c{0, 0, 0};
+    for (int d = 0; d < D; ++d) c[d] = cell_of(p.x[d][i], G.origin[d], Real(1) / G.h[d]);
+    p.key[i] = tiles.key(c);
+  }
+  std::vector<std::uint32_t> offsets, perm;
+  counting_sort(p.key.data(), p.n, tiles.key_count(), offsets, perm);
+  return perm;
+}
+
+struct TileRanges {
+  std::vector<std::uint32_t> begin;                 // per tile, tile_count + 1
+  std::array<std::vector<std::uint32_t>, 8> color;  // non-empty tiles per color
+};
+
+template <int D>
+TileRanges tile_ranges(const std::vector<std::uint32_t>& sorted_keys, const TileLayout<D>& tiles) {
+  TileRanges r;
+  r.begin.assign(std::size_t(tiles.tile_count) + 1, 0);
+  for (std::uint32_t k : sorted_keys) ++r.begin[k / tiles.keys_per_tile + 1];
+  for (std::uint32_t t = 0; t < tiles.tile_count; ++t) r.begin[t + 1] += r.begin[t];
+  for (std::uint32_t t = 0; t < tiles.tile_count; ++t)
+    if (r.begin[t + 1] > r.begin[t]) r.color[std::size_t(tiles.color(t))].push_back(t);
+  return r;
+}
+
+// The colored scatter (as Stepper::p2g runs it), with `threads` OpenMP threads.
+// Returns the number of threads the parallel regions actually had.
+template <int D, class Shape, class Real, unsigned What, bool MF, bool TR>
+int colored_p2g(const ParticleView<D, Real>& P, const GridView<D, Real>& G, const P2GOptions& opt,
+                const TileRanges& r, int threads) {
+  int team = 0;
+  std::size_t bad = SIZE_MAX;
+  for (const auto& list : r.color) {
+    const std::size_t nt = list.size();
+#pragma omp parallel num_threads(threads) reduction(min : bad)
+    {
+#pragma omp single
+      team = std::max(team, omp_get_num_threads());
+#pragma omp for schedule(dynamic, 1)
+      for (std::size_t k = 0; k < nt; ++k) {
+        const std::uint32_t t = list[k];
+        const std::size_t b = r.begin[t], e = r.begin[t + 1];
+        const std::size_t got = p2g_range<D, Shape, Real, What, MF, TR>(P, G, opt, b, e);
+        if (got != e) bad = std::min(bad, got);
+      }
+    }
+  }
+  EXPECT_EQ(bad, SIZE_MAX) << "a stencil left the grid";
+  return team;
+}
+
+template <class Real>
+bool bitwise_equal(const std::vector<Real>& a, const std::vector<Real>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(Real)) == 0;
+}
+
+template <class Real>
+std::size_t first_difference(const std::vector<Real>& a, const std::vector<Real>& b) {
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (std::memcmp(&a[i], &b[i], sizeof(Real)) != 0) return i;
+  return a.size();
+}
+
+template <class C>
+class P2G : public ::testing::Test {};
+
+using Configs = ::testing::Types<Cfg<2, LinearShape, double>, Cfg<2, GimpShape, double>,
+                                 Cfg<2, GimpShape, float>, Cfg<2, BSpline2Shape, double>,
+                                 Cfg<2, BSpline3Shape, float>, Cfg<3, GimpShape, double>,
+                                 Cfg<3, LinearShape, float>, Cfg<3, BSpline2Shape, double>,
+                                 Cfg<3, BSpline3Shape, double>>;
+struct CfgNames {
+  template <class C>
+  static std::string GetName(int) {
+    return std::to_string(C::D) + "D_" + C::Shape::name + "_" +
+           (sizeof(typename C::Real) == 8 ? "double" : "float");
+  }
+};
+TYPED_TEST_SUITE(P2G, Configs, CfgNames);
+
+template <class Real>
+constexpr double conservation_tol() {
+  return sizeof(Real) == 8 ? 1e-12 : 2e-5;
+}
+
+// Conservation of mass, momentum, force, domain and displacement moments by
+// one serial scatter in natural particle order.
+template <int D, class Shape, class Real, bool MF, bool TR>
+void check_conservation(unsigned seed, bool constant_stress) {
+  constexpr int NS = kStressComponents<D>;
+  const bool gimp = std::string(Shape::name) == "gimp";
+  const int fields = MF ? 2 : 1;
+  Grid<D, Real> g(grid_cells<D>(), fields);
+  const std::size_t n = D == 2 ? 6000 : 4000;
+  auto p = random_particles<D, Real>(g.G, g.cells, n, seed);
+  if (constant_stress)
+    for (int c = 0; c < NS; ++c) std::fill(p.s[c].begin(), p.s[c].end(), Real(1.5 + c));
+  if (!MF) std::fill(p.field.begin(), p.field.end(), std::uint8_t(0));
+  const auto P = p.view(gimp);
+  P2GOptions opt;
+  opt.inv_thickness = 0.5;  // 2D: Omega holds areas = V / thickness
+  constexpr unsigned What = MF ? kAll : (kMassMomentum | kForce);
+  ASSERT_EQ((p2g_range<D, Shape, Real, What, MF, TR>(P, g.G, opt, 0, n)), n);
+
+  const double tol = conservation_tol<Real>();
+  double m = 0, mf[2] = {0, 0}, mom[D] = {}, mom_abs = 0, fe[D] = {}, fe_abs = 0, area = 0, mx[D] = {},
+         mx_abs = 0, force_scale = 0;
+  double inv_h = 0;
+  for (int d = 0; d < D; ++d) inv_h = std::max(inv_h, 1.0 / double(g.G.h[d]));
+  for (std::size_t i = 0; i < n; ++i) {
+    m += double(p.m[i]);
+    mf[p.field[i]] += double(p.m[i]);
+    double smax = 0;
+    for (int c = 0; c < NS; ++c) smax = std::max(smax, std::abs(double(p.s[c][i])));
+    force_scale += double(p.V[i]) * smax * D * inv_h;
+    area += double(p.V[i]) * (D == 2 ? opt.inv_thickness : 1.0);
+    for (int d = 0; d < D; ++d) {
+      mom[d] += double(p.m[i]) * double(p.v[d][i]);
+      mom_abs += std::abs(double(p.m[i]) * double(p.v[d][i]));
+      if (TR) fe[d] += double(p.fext[d][i]), fe_abs += std::abs(double(p.fext[d][i]));
+      const double u = double(p.x[d][i]) - double(p.x0[d][i]);
+      mx[d] += double(p.m[i]) * u;
+      mx_abs += std::abs(double(p.m[i]) * u);
+    }
+  }
+  EXPECT_NEAR(g.sum(g.G.m), m, tol * m) << "mass";
+  if (MF) {
+    for (int f = 0; f < 2; ++f) {
+      EXPECT_NEAR(g.sum_field(g.G.m, f), mf[f], tol * m) << "mass of field " << f;
+    }
+  }
+  for (int d = 0; d < D; ++d) {
+    EXPECT_NEAR(g.sum(g.G.p[d]), mom[d], tol * mom_abs) << "momentum " << d;
+    EXPECT_NEAR(g.sum(g.G.f[d]), fe[d], tol * (force_scale + fe_abs)) << "force sum " << d;
+  }
+  if (MF) {
+    EXPECT_NEAR(g.sum(g.G.vol), area, tol * area) << "nodal domains";
+    for (int d = 0; d < D; ++d) {
+      EXPECT_NEAR(g.sum(g.G.mx[d]), mx[d], tol * mx_abs) << "mass-weighted displacement " << d;
+      EXPECT_NEAR(g.sum(g.G.g[d]), 0.0, tol * area * D * inv_h * 4) << "domain gradient " << d;
+    }
+  }
+}
+
+TYPED_TEST(P2G, ConservesMassMomentumForceMultiField) {
+  check_conservation<TypeParam::D, typename TypeParam::Shape, typename TypeParam::Real, true, true>(101, false);
+}
+TYPED_TEST(P2G, ConservesMassMomentumForceSingleField) {
+  check_conservation<TypeParam::D, typename TypeParam::Shape, typename TypeParam::Real, false, false>(102, false);
+}
+// Divergence of a constant stress field: the internal forces sum to zero.
+TYPED_TEST(P2G, ConstantStressForcesSumToZero) {
+  check_conservation<TypeParam::D, typename TypeParam::Shape, typename TypeParam::Real, false, false>(103, true);
+}
+
+// Two tiles of one color never share a node under the shape function's stencil.
+TYPED_TEST(P2G, SameColorTilesTouchDisjointNodes) {
+  constexpr int D = TypeParam::D;
+  using Shape = typename TypeParam::Shape;
+  using Real = typename TypeParam::Real;
+  const bool gimp = std::string(Shape::name) == "gimp";
+  for (int T : {3, 4, 8}) {
+    Grid<D, Real> g(grid_cells<D>(), 1);
+    auto p = random_particles<D, Real>(g.G, g.cells, D == 2 ? 6000 : 4000, 200 + unsigned(T));
+    for (int d = 0; d < D; ++d) std::fill(p.lp[d].begin(), p.lp[d].end(), Real(0.5));  // widest uGIMP
+    TileLayout<D> tiles;
+    tiles.setup(T, g.cells);
+    auto sorted = p.permuted(sort_by_tile(p, g.G, tiles));
+    const auto P = sorted.view(gimp);
+    const std::array<Real, 3> inv_h{Real(1) / g.G.h[0], Real(1) / g.G.h[1], Real(1) / g.G.h[2]};
+    std::vector<std::int64_t> owner(g.G.nodes);
+    for (int color = 0; color < (1 << D); ++color) {
+      std::fill(owner.begin(), owner.end(), -1);
+      for (std::size_t i = 0; i < sorted.n; ++i) {
+        const std::uint32_t tile = sorted.key[i] / tiles.keys_per_tile;
+        if (tiles.color(tile) != color) continue;
+        Stencil<D, Shape, Real> st;
+        ASSERT_TRUE(st.build(P, g.G, inv_h, i));
+        for (int k = 0; k < st.count; ++k) {
+          const std::size_t node = st.base + st.node[k];
+          if (owner[node] >= 0) {
+            ASSERT_EQ(owner[node], std::int64_t(tile)) << "T=" << T << ": tiles " << owner[node] << " and "
+                                                       << tile << " (color " << color << ") share node " << node;
+          }
+          owner[node] = tile;
+        }
+      }
+    }
+  }
+}
+
+// The colored scatter: 2 threads = 1 thread = its serial twin, bitwise;
+// = serial in sorted and in natural order to round-off.
+template <int D, class Shape, class Real, bool MF, bool TR>
+void check_colored(int T, unsigned seed) {
+  constexpr unsigned What = MF ? kAll : (kMassMomentum | kForce);
+  const bool gimp = std::string(Shape::name) == "gimp";
+  const int fields = MF ? 2 : 1;
+  const std::size_t n = D == 2 ? 6000 : 4000;
+  Grid<D, Real> natural(grid_cells<D>(), fields), serial(grid_cells<D>(), fields),
+      sorted_serial(grid_cells<D>(), fields), one(grid_cells<D>(), fields), two(grid_cells<D>(), fields);
+  auto p = random_particles<D, Real>(natural.G, natural.cells, n, seed);
+  if (!MF) std::fill(p.field.begin(), p.field.end(), std::uint8_t(0));
+  P2GOptions opt;
+  opt.inv_thickness = 0.5;
+
+  ASSERT_EQ((p2g_range<D, Shape, Real, What, MF, TR>(p.view(gimp), natural.G, opt, 0, n)), n);
+
+  TileLayout<D> tiles;
+  tiles.setup(T, natural.cells);
+  auto sorted = p.permuted(sort_by_tile(p, natural.G, tiles));
+  for (std::size_t i = 1; i < n; ++i) ASSERT_LE(sorted.key[i - 1], sorted.key[i]) << "sorted by key";
+  const auto P = sorted.view(gimp);
+  const TileRanges r = tile_ranges<D>(sorted.key, tiles);
+  int colors_used = 0;
+  for (const auto& c : r.color) colors_used += !c.empty();
+  ASSERT_EQ(colors_used, 1 << D) << "every color has tiles";
+
+  ASSERT_EQ((p2g_range<D, Shape, Real, What, MF, TR>(P, sorted_serial.G, opt, 0, n)), n);
+  for (const auto& list : r.color)  // serial twin of the colored scatter, no OpenMP
+    for (std::uint32_t t : list)
+      ASSERT_EQ((p2g_range<D, Shape, Real, What, MF, TR>(P, serial.G, opt, r.begin[t], r.begin[t + 1])),
+                r.begin[t + 1]);
+  colored_p2g<D, Shape, Real, What, MF, TR>(P, one.G, opt, r, 1);
+  const int team = colored_p2g<D, Shape, Real, What, MF, TR>(P, two.G, opt, r, 2);
+  ASSERT_EQ(team, 2) << "the parallel scatter must really run on 2 threads";
+
+  const double tol = sizeof(Real) == 8 ? 1e-12 : 1e-4;
+  for (std::size_t a = 0; a < natural.arrays.size(); ++a) {
+    const auto& nat = natural.arrays[a];
+    const auto& c2 = two.arrays[a];
+    EXPECT_TRUE(bitwise_equal(c2, one.arrays[a]))
+        << "array " << a << ": 2 threads differ from 1 thread at entry " << first_difference(c2, one.arrays[a]);
+    const std::size_t i = first_difference(c2, serial.arrays[a]);
+    EXPECT_EQ(i, c2.size()) << "array " << a << ": colored scatter differs from its serial twin at entry "
+                            << i << ": " << (i < c2.size() ? double(c2[i]) : 0.0) << " vs "
+                            << (i < c2.size() ? double(serial.arrays[a][i]) : 0.0);
+    double scale = 0, diff_nat = 0, diff_sorted = 0;
+    for (std::size_t k = 0; k < nat.size(); ++k) {
+      scale = std::max(scale, std::abs(double(nat[k])));
+      diff_nat = std::max(diff_nat, std::abs(double(nat[k]) - double(c2[k])));
+      diff_sorted = std::max(diff_sorted, std::abs(double(sorted_serial.arrays[a][k]) - double(c2[k])));
+    }
+    EXPECT_GT(scale, 0.0) << "array " << a << " was filled";
+    EXPECT_LE(diff_nat, tol * scale) << "array " << a << ": colored vs natural order";
+    EXPECT_LE(diff_sorted, tol * scale) << "array " << a << ": colored vs sorted order";
+  }
+}
+
+TYPED_TEST(P2G, ColoredScatterMatchesSerialMultiFieldTile3) {
+  check_colored<TypeParam::D, typename TypeParam::Shape, typename TypeParam::Real, true, true>(3, 301);
+}
+TYPED_TEST(P2G, ColoredScatterMatchesSerialSingleFieldTile4) {
+  check_colored<TypeParam::D, typename TypeParam::Shape, typename TypeParam::Real, false, false>(4, 302);
+}
+TYPED_TEST(P2G, ColoredScatterMatchesSerialMultiFieldTile8) {
+  check_colored<TypeParam::D, typename TypeParam::Shape, typename TypeParam::Real, true, false>(TypeParam::D == 2 ? 8 : 4, 303);
+}
+
+}  // namespace

@@ -1,0 +1,38 @@
+// Helpers for validation tests that drive the solver through the
+// Simulation interface (scene text in, particle fields out).
+#pragma once
+
+#include <omp.h>
+
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "scene/parse.hpp"
+#include "solver/simulation.hpp"
+
+namespace mmpm::testing {
+
+inline std::unique_ptr<Simulation> make_from_text(const std::string& toml,
+                                                  const std::vector<std::string>& overrides = {}) {
+  return make_simulation(parse_scene_text(toml, "test.toml", overrides));
+}
+
+// Steps until the simulated time reaches t_end (the scene's end_time is not consulted).
+inline void run_until(Simulation& sim, double t_end) {
+  while (sim.time() < t_end - 1e-9 * sim.dt()) sim.step();
+}
+
+struct Column {
+  std::vector<double> values;
+  int components = 1;
+  double at(std::size_t p, int c = 0) const { return values[p * std::size_t(components) + std::size_t(c)]; }
+};
+
+inline Column field(const Simulation& sim, const std::string& name) {
+  auto f = sim.particle_field(name);
+  return {std::move(f.values), f.components};
+}
+
+}  // namespace mmpm::testing
