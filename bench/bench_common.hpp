@@ -78,6 +78,15 @@ inline double& time_scale() {
 }
 inline double min_time(double seconds) { return seconds * time_scale(); }
 
+// benchmark::DoNotOptimize through a const reference: the value is an asm
+// input, never rewritten. (The non-const overload of Google Benchmark 1.7.1
+// uses an "+m,r" constraint that GCC miscompiles for doubles: google/benchmark
+// issue #903, GCC bug 92597 — it returned pointer bits as a double here.)
+template <class T>
+inline void keep(const T& value) {
+  benchmark::DoNotOptimize(value);
+}
+
 // Thread count for the OpenMP kernels of one benchmark.
 inline void use_threads(int threads) { omp_set_num_threads(threads); }
 

@@ -85,7 +85,7 @@ void bm_g2p(benchmark::State& state, int threads) {
       const std::size_t b = c * kReduceChunk, e = std::min(n, b + kReduceChunk);
       res[c] = g2p_range<D, Shape, Real, What, false, false, false>(P, G, V, q, key_of, b, e);
     }
-    benchmark::DoNotOptimize(res.data());
+    keep(res.data());
     benchmark::ClobberMemory();
   }
   for (const auto& r : res)
@@ -125,7 +125,7 @@ void bm_constitutive(benchmark::State& state, int threads) {
   const double dt = 1e-4;
   for (auto _ : state) {
     isotropic_update<D, Real>(P, nullptr, P.n, c, dt);
-    benchmark::DoNotOptimize(P.s[0]);
+    keep(P.s[0]);
     benchmark::ClobberMemory();
   }
   if (!std::isfinite(double(P.s[0][0])) || !(P.V[0] > 0)) {

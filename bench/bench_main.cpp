@@ -29,6 +29,16 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::AddCustomContext("omp_max_threads", std::to_string(omp_get_max_threads()));
+#ifdef MMPM_FAST_DEV
+  benchmark::AddCustomContext("mmpm_fast_dev", "ON");
+#else
+  benchmark::AddCustomContext("mmpm_fast_dev", "OFF");
+#endif
+#ifdef NDEBUG
+  benchmark::AddCustomContext("mmpm_asserts", "off");
+#else
+  benchmark::AddCustomContext("mmpm_asserts", "on");
+#endif
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   return 0;

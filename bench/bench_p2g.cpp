@@ -88,8 +88,8 @@ void bm_p2g(benchmark::State& state, Strategy strategy, int tile, int threads) {
         bad = p2g_atomic<D, Shape, Real>(P, G);
         break;
     }
-    benchmark::DoNotOptimize(bad);
-    benchmark::DoNotOptimize(G.m);
+    keep(bad);
+    keep(G.m);
     benchmark::ClobberMemory();
   }
   if (bad != SIZE_MAX) {
@@ -163,9 +163,13 @@ void register_p2g() {
   register_shapes<2, float>();
   register_shapes<3, double>();
   register_shapes<3, float>();
+  register_tiles<2, LinearShape, double>();
   register_tiles<2, GimpShape, double>();
+  register_tiles<2, BSpline2Shape, double>();
   register_tiles<2, BSpline3Shape, double>();
+  register_tiles<3, LinearShape, double>();
   register_tiles<3, GimpShape, double>();
+  register_tiles<3, BSpline2Shape, double>();
   register_tiles<3, BSpline3Shape, double>();
 }
 

@@ -89,7 +89,7 @@ void bm_sort(benchmark::State& state, bool shuffled, int threads) {
     const auto t3 = Clock::now();
     fx.bins.rebuild_ranges(fx.S);
     const auto t4 = Clock::now();
-    benchmark::DoNotOptimize(fx.bins.tile_begin.data());
+    keep(fx.bins.tile_begin.data());
     benchmark::ClobberMemory();
     t_keys += std::chrono::duration<double>(t1 - t0).count();
     t_count += std::chrono::duration<double>(t2 - t1).count();

@@ -21,20 +21,25 @@ namespace mmpm {
 
 template <int D>
 struct TileLayout {
-  int T = 8;                        // tile edge in cells
+  int T = 8;                        // tile edge in cells: a power of two (shifts, not divisions)
+  int shift = 3;                    // log2(T)
   std::array<int, 3> cells{1, 1, 1};
   std::array<int, 3> tiles{1, 1, 1};
   std::uint32_t keys_per_tile = 1;  // T^D
+  int key_shift = 3 * D;            // log2(keys_per_tile)
   std::uint32_t tile_count = 1;
 
+  // tile_edge is rounded up to a power of two, at least 4.
   void setup(int tile_edge, const std::array<int, 3>& grid_cells) {
-    T = tile_edge;
+    shift = 2;
+    while ((1 << shift) < tile_edge) ++shift;
+    T = 1 << shift;
+    key_shift = D * shift;
     cells = grid_cells;
-    keys_per_tile = 1;
+    keys_per_tile = 1u << key_shift;
     tile_count = 1;
     for (int d = 0; d < D; ++d) {
-      tiles[d] = (cells[d] + T - 1) / T;
-      keys_per_tile *= std::uint32_t(T);
+      tiles[d] = (cells[d] + T - 1) >> shift;
       tile_count *= std::uint32_t(tiles[d]);
     }
   }
@@ -43,16 +48,16 @@ struct TileLayout {
   // Key of a cell given by its integer indices (clamped into the grid so that
   // a particle exactly on the upper boundary still gets a valid key).
   std::uint32_t key(const std::array<int, 3>& c_in) const {
-    std::uint32_t tile = 0, local = 0, tstride = 1, lstride = 1;
+    std::uint32_t tile = 0, local = 0, tstride = 1;
     for (int d = 0; d < D; ++d) {
-      int c = c_in[d] < 0 ? 0 : (c_in[d] >= cells[d] ? cells[d] - 1 : c_in[d]);
-      tile += std::uint32_t(c / T) * tstride;
-      local += std::uint32_t(c % T) * lstride;
+      const int c = c_in[d] < 0 ? 0 : (c_in[d] >= cells[d] ? cells[d] - 1 : c_in[d]);
+      tile += std::uint32_t(c >> shift) * tstride;
+      local |= std::uint32_t(c & (T - 1)) << (d * shift);
       tstride *= std::uint32_t(tiles[d]);
-      lstride *= std::uint32_t(T);
     }
-    return tile * keys_per_tile + local;
+    return (tile << key_shift) | local;
   }
+  std::uint32_t tile_of_key(std::uint32_t k) const { return k >> key_shift; }
   int color(std::uint32_t tile) const {
     int col = 0;
     for (int d = 0; d < D; ++d) {

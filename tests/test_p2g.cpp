@@ -439,7 +439,9 @@ void check_colored(int T, unsigned seed) {
       diff_nat = std::max(diff_nat, std::abs(double(nat[k]) - double(c2[k])));
       diff_sorted = std::max(diff_sorted, std::abs(double(sorted_serial.arrays[a][k]) - double(c2[k])));
     }
-    EXPECT_GT(scale, 0.0) << "array " << a << " was filled";
+    if (MF || a < std::size_t(1 + 2 * D)) {
+      EXPECT_GT(scale, 0.0) << "array " << a << " was filled";
+    }
     EXPECT_LE(diff_nat, tol * scale) << "array " << a << ": colored vs natural order";
     EXPECT_LE(diff_sorted, tol * scale) << "array " << a << ": colored vs sorted order";
   }

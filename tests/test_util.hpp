@@ -165,7 +165,7 @@ inline CmdResult run_command(std::vector<std::string> args, const std::string& c
 }
 
 // `mmpm ARGS...` through the real binary.
-inline CmdResult mmpm(const std::vector<std::string>& args, const std::string& cwd = "") {
+inline CmdResult run_mmpm(const std::vector<std::string>& args, const std::string& cwd = "") {
   std::vector<std::string> all{mmpm_binary()};
   all.insert(all.end(), args.begin(), args.end());
   return run_command(all, cwd);

@@ -5,6 +5,7 @@
 #include <omp.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <memory>
 #include <string>
 #include <vector>
@@ -36,3 +37,10 @@ inline Column field(const Simulation& sim, const std::string& name) {
 }
 
 }  // namespace mmpm::testing
+
+// Long validation cases (refinement studies) run only under `ctest -L long`
+// (which sets MMPM_LONG=1); in CI they report as skipped.
+#define MMPM_LONG_TEST()                                                   \
+  do {                                                                     \
+    if (!std::getenv("MMPM_LONG")) GTEST_SKIP() << "long test: run ctest -L long"; \
+  } while (0)

@@ -150,6 +150,8 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
   DriverState st;
   st.names = series_names(*sim);
 
+  // Every requested output field must exist before anything is written.
+  (void)sim->snapshot(scene.output.fields);
   fs::create_directories(dir);
   std::unique_ptr<io::RunWriter> writer;
   if (resume) {

@@ -68,13 +68,13 @@ class Stepper final : public Simulation {
   struct KeyFn {
     const Stepper* s;
     std::uint32_t tile(std::size_t p) const { return s->tile_of_position(p); }
-    std::uint32_t tile_of_key(std::uint32_t k) const { return k / s->tiles_.keys_per_tile; }
+    std::uint32_t tile_of_key(std::uint32_t k) const { return s->tiles_.tile_of_key(k); }
   };
 
   void setup_particles(const ParticleSeeds& seeds);
   void setup_grid();
   std::uint32_t key_of_position(std::size_t p) const;
-  std::uint32_t tile_of_position(std::size_t p) const { return key_of_position(p) / tiles_.keys_per_tile; }
+  std::uint32_t tile_of_position(std::size_t p) const { return tiles_.tile_of_key(key_of_position(p)); }
   void sort_particles();
   void rebuild_ranges();
   void zero_grid(bool mm);

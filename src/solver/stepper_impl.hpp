@@ -14,7 +14,6 @@ Stepper<D, Shape, Real>::Stepper(const Scene& scene) : scene_(scene), plan_(plan
   for (const auto& l : scene.loads) {
     if (l.kind == LoadKind::gravity) {
       has_gravity_ = true;
-      for (int d = 0; d < D; ++d) gravity_[d] += l.acceleration[d];
     } else {
       has_traction_ = true;
       traction_ramp_end_ = std::max(traction_ramp_end_, l.ramp);
@@ -55,7 +54,7 @@ void Stepper<D, Shape, Real>::setup_grid() {
     }
   }
   int T = g.tile > 0 ? g.tile : (D == 2 ? 8 : 4);
-  tiles_.setup(std::max(3, T), g.cells);
+  tiles_.setup(T, g.cells);
 }
 
 template <int D, class Shape, class Real>
@@ -81,6 +80,7 @@ void Stepper<D, Shape, Real>::setup_particles(const ParticleSeeds& seeds) {
   if (has_traction_)
     for (int d = 0; d < D; ++d) P_.fext[d] = pcols_.add_real(std::string("fext") + axis[d], n);
   P_.mat = pcols_.add_byte("mat", n);
+  std::uint8_t* body = pcols_.add_byte("body", n);
   if (plan_.multimaterial) P_.field = pcols_.add_byte("field", n);
   if (has_traction_) {
     // Base traction force and load index travel with the particle as columns.
@@ -106,11 +106,12 @@ void Stepper<D, Shape, Real>::setup_particles(const ParticleSeeds& seeds) {
     if (P_.F[0])
       for (int c = 0; c < D * D; ++c) P_.F[c][p] = (c % (D + 1)) == 0 ? Real(1) : Real(0);
     P_.mat[p] = std::uint8_t(seeds.material[p]);
+    body[p] = std::uint8_t(std::min(seeds.body[p], 255));
     if (P_.field) P_.field[p] = std::uint8_t(plan_.field_of_material[std::size_t(seeds.material[p])]);
     if (has_traction_) {
       Real* base[3] = {pcols_.real("fbasex"), pcols_.real("fbasey"), D == 3 ? pcols_.real("fbasez") : nullptr};
       for (int d = 0; d < D; ++d) base[d][p] = Real(seeds.traction_force[p][d]);
-      pcols_.bytes.back()[p] = std::uint8_t(seeds.load[p] < 0 ? 255 : seeds.load[p]);
+      pcols_.byte("load")[p] = std::uint8_t(seeds.load[p] < 0 ? 255 : seeds.load[p]);
     }
   }
   // Fields lighter than this at a node are empty there (ALGORITHM §4.3).
@@ -165,7 +166,7 @@ void Stepper<D, Shape, Real>::rebuild_ranges() {
   const std::size_t n = P_.n;
   const std::uint32_t nt = tiles_.tile_count;
   tile_begin_.assign(std::size_t(nt) + 1, 0);
-  for (std::size_t p = 0; p < n; ++p) ++tile_begin_[P_.key[p] / tiles_.keys_per_tile + 1];
+  for (std::size_t p = 0; p < n; ++p) ++tile_begin_[tiles_.tile_of_key(P_.key[p]) + 1];
   for (std::uint32_t t = 0; t < nt; ++t) tile_begin_[t + 1] += tile_begin_[t];
   for (auto& c : color_tiles_) c.clear();
   for (std::uint32_t t = 0; t < nt; ++t)
@@ -350,7 +351,7 @@ void Stepper<D, Shape, Real>::update_tractions() {
   if (!has_traction_) return;
   if (time_ > traction_ramp_end_ + dt_ && step_ > 1) return;
   const std::size_t n = P_.n;
-  const std::uint8_t* load = pcols_.bytes.back().data();
+  const std::uint8_t* load = pcols_.byte("load");
   Real* base[3] = {pcols_.real("fbasex"), pcols_.real("fbasey"), D == 3 ? pcols_.real("fbasez") : nullptr};
   std::vector<Real> scale(scene_.loads.size() + 1, Real(0));
   for (std::size_t l = 0; l < scene_.loads.size(); ++l) {
@@ -375,6 +376,15 @@ void Stepper<D, Shape, Real>::step() {
     if (m < 0) continue;
     const Vec3 v = rigid_velocity(scene_.materials[std::size_t(m)], time_ + dt_);
     for (int d = 0; d < 3; ++d) rigid_velocity_now_[std::size_t(f) * 3 + std::size_t(d)] = v[d];
+  }
+  if (has_gravity_) {
+    // Gravity at mid-step, ramped linearly when the load has a ramp.
+    gravity_ = {0, 0, 0};
+    for (const auto& l : scene_.loads) {
+      if (l.kind != LoadKind::gravity) continue;
+      const double f = l.ramp > 0 ? std::min(1.0, (time_ + 0.5 * dt_) / l.ramp) : 1.0;
+      for (int d = 0; d < D; ++d) gravity_[d] += f * l.acceleration[d];
+    }
   }
   tic();
   const int every = scene_.simulation.sort_every;
@@ -462,7 +472,7 @@ void Stepper<D, Shape, Real>::step() {
 #pragma omp parallel for schedule(static) reduction(|| : moved) if (np >= kParallelMin)
     for (std::size_t p = 0; p < np; ++p) {
       for (int d = 0; d < D; ++d) P_.x[d][p] = P_.x_next[d][p];
-      moved = moved || tile_of_position(p) != P_.key[p] / tiles_.keys_per_tile;
+      moved = moved || tile_of_position(p) != tiles_.tile_of_key(P_.key[p]);
     }
     if (moved) dirty_ = true;
     for (int d = 0; d < D; ++d) P_.x_next[d] = nullptr;
@@ -575,12 +585,58 @@ io::ParticleField Stepper<D, Shape, Real>::particle_field(const std::string& nam
     out.values.resize(n * NS);
     for (std::size_t p = 0; p < n; ++p)
       for (int c = 0; c < NS; ++c) out.values[p * NS + std::size_t(c)] = double(P_.s[c][p]);
+  } else if (name == "strain") {
+    // Small-strain materials: eps = S sigma (tensor components, as the
+    // stress); finite-strain ones: Green-Lagrange E = (F^T F - I) / 2.
+    out.components = NS;
+    out.values.resize(n * NS);
+    for (std::size_t p = 0; p < n; ++p) {
+      const MaterialModel& mat = materials_[P_.mat[p]];
+      double e[6] = {0, 0, 0, 0, 0, 0};  // Voigt xx yy zz yz xz xy, tensor shear
+      if (mat.finite_strain()) {
+        double F[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+        for (int i = 0; i < D; ++i)
+          for (int j = 0; j < D; ++j) F[i * 3 + j] = double(P_.F[i * D + j][p]);
+        auto C = [&](int i, int j) { return F[i] * F[j] + F[3 + i] * F[3 + j] + F[6 + i] * F[6 + j]; };
+        e[0] = 0.5 * (C(0, 0) - 1), e[1] = 0.5 * (C(1, 1) - 1), e[2] = 0.5 * (C(2, 2) - 1);
+        e[3] = 0.5 * C(1, 2), e[4] = 0.5 * C(0, 2), e[5] = 0.5 * C(0, 1);
+      } else if (!mat.rigid()) {
+        double sv[6] = {0, 0, 0, 0, 0, 0};
+        if constexpr (D == 2) {
+          sv[0] = double(P_.s[0][p]), sv[1] = double(P_.s[1][p]), sv[2] = double(P_.s[3][p]), sv[5] = double(P_.s[2][p]);
+        } else {
+          for (int c = 0; c < 6; ++c) sv[c] = double(P_.s[c][p]);
+        }
+        for (int i = 0; i < 6; ++i) {
+          for (int j = 0; j < 6; ++j) e[i] += mat.compliance[i][j] * sv[j];
+          if (i >= 3) e[i] *= 0.5;
+        }
+      }
+      double* o = &out.values[p * NS];
+      if constexpr (D == 2) {
+        o[0] = e[0], o[1] = e[1], o[2] = e[5], o[3] = e[2];
+      } else {
+        for (int c = 0; c < 6; ++c) o[c] = e[c];
+      }
+    }
+  } else if (name == "deformation_gradient") {
+    if (!P_.F[0])
+      throw InputError("output field 'deformation_gradient' needs a finite-strain (neohookean) material");
+    out.components = D * D;
+    out.values.resize(n * D * D);
+    for (std::size_t p = 0; p < n; ++p)
+      for (int c = 0; c < D * D; ++c) out.values[p * D * D + std::size_t(c)] = double(P_.F[c][p]);
+  } else if (name == "body") {
+    out.values.resize(n);
+    const std::uint8_t* body = pcols_.byte("body");
+    for (std::size_t p = 0; p < n; ++p) out.values[p] = double(body[p]);
   } else if (name == "material" || name == "mass" || name == "volume") {
     out.values.resize(n);
     for (std::size_t p = 0; p < n; ++p)
       out.values[p] = name == "material" ? double(P_.mat[p]) : (name == "mass" ? double(P_.m[p]) : double(P_.V[p]));
   } else {
-    throw InputError("output field '" + name + "' is unknown (position, displacement, velocity, stress, material, mass, volume)");
+    throw InputError("output field '" + name + "' is unknown (position, displacement, velocity, stress, strain, "
+                     "material, body, mass, volume, deformation_gradient)");
   }
   return out;
 }

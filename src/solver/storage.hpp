@@ -30,6 +30,16 @@ struct ColumnSet {
     bytes.emplace_back(n, next_slot++);
     return bytes.back().data();
   }
+  std::uint8_t* byte(const std::string& name) {
+    for (std::size_t i = 0; i < byte_names.size(); ++i)
+      if (byte_names[i] == name) return bytes[i].data();
+    return nullptr;
+  }
+  const std::uint8_t* byte(const std::string& name) const {
+    for (std::size_t i = 0; i < byte_names.size(); ++i)
+      if (byte_names[i] == name) return bytes[i].data();
+    return nullptr;
+  }
   Real* real(const std::string& name) {
     for (std::size_t i = 0; i < real_names.size(); ++i)
       if (real_names[i] == name) return reals[i].data();

@@ -1,0 +1,407 @@
+#!/usr/bin/python3
+"""Turns mmpm_bench's JSON (Google Benchmark 1.7.1) into Markdown tables.
+
+    bench/table.py [bench/results.json] [-o bench/RESULTS.md] [--load-after "..."]
+
+Benchmark names are "family/key:value/..." (see bench/bench_common.hpp);
+aggregates of repeated runs are read through their median (and cv for the
+noise). Standard library only.
+"""
+
+import argparse
+import datetime
+import json
+import os
+import subprocess
+import sys
+
+STAGES = ["sort", "p2g", "mm", "grid", "g2p", "constitutive"]
+SHAPES = ["linear", "gimp", "bspline2", "bspline3"]
+LAWS = ["stick", "frictionless", "friction", "interface"]
+NORMALS = ["mvg", "avg", "specified", "radial"]
+
+
+def parse_name(name):
+    parts = name.split("/")
+    info = {"family": parts[0]}
+    for p in parts[1:]:
+        if ":" in p:
+            k, v = p.split(":", 1)
+            if k not in ("min_time", "repeats"):
+                info[k] = v
+    return info
+
+
+def load(path):
+    with open(path) as f:
+        data = json.load(f)
+    runs = {}  # key (tuple of name items) -> dict of values
+    errors = []
+    for b in data.get("benchmarks", []):
+        name = b.get("run_name", b["name"])
+        if b.get("error_occurred"):
+            errors.append((name, b.get("error_message", "")))
+            continue
+        info = parse_name(name)
+        key = tuple(sorted(info.items()))
+        rec = runs.setdefault(key, {"info": info})
+        if b.get("run_type") == "aggregate":
+            agg = b.get("aggregate_name")
+            if agg == "median":
+                rec["values"] = b
+            elif agg == "cv":
+                rec["cv"] = b
+        else:
+            rec.setdefault("values", b)
+    return data.get("context", {}), runs, errors
+
+
+class Results:
+    def __init__(self, runs):
+        self.runs = runs
+
+    def find(self, family, **want):
+        """The run of `family` whose name has exactly these key:value items."""
+        want = {k: str(v) for k, v in want.items()}
+        want["family"] = family
+        for rec in self.runs.values():
+            if rec["info"] == want and "values" in rec:
+                return rec
+        return None
+
+    def value(self, family, counter, **want):
+        rec = self.find(family, **want)
+        if rec is None:
+            return None
+        return rec["values"].get(counter)
+
+    def cv(self, family, counter, **want):
+        rec = self.find(family, **want)
+        if rec is None or "cv" not in rec:
+            return None
+        return rec["cv"].get(counter)
+
+
+def fmt(x, digits=1):
+    if x is None:
+        return "–"
+    if abs(x) >= 1000:
+        return f"{x:,.0f}"
+    if abs(x) >= 100:
+        return f"{x:.0f}"
+    return f"{x:.{digits}f}"
+
+
+def ratio(a, b, digits=2):
+    if a is None or b is None or b == 0:
+        return "–"
+    return f"{a / b:.{digits}f}×"
+
+
+def pct(x):
+    return "–" if x is None else f"{100 * x:.1f} %"
+
+
+def table(header, rows):
+    out = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
+    for r in rows:
+        out.append("| " + " | ".join(r) + " |")
+    return "\n".join(out)
+
+
+def lscpu_model():
+    try:
+        text = subprocess.run(["lscpu"], capture_output=True, text=True, check=True).stdout
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown", "?"
+    model, cpus = "unknown", "?"
+    for line in text.splitlines():
+        k, _, v = line.partition(":")
+        if k.strip() == "Model name":
+            model = v.strip()
+        elif k.strip() == "CPU(s)":
+            cpus = v.strip()
+    return model, cpus
+
+
+def git_commit(root):
+    try:
+        rev = subprocess.run(["git", "-C", root, "rev-parse", "--short", "HEAD"],
+                             capture_output=True, text=True, check=True).stdout.strip()
+        dirty = subprocess.run(["git", "-C", root, "status", "--porcelain", "--untracked-files=no"],
+                               capture_output=True, text=True, check=True).stdout.strip()
+        return rev + ("+dirty" if dirty else "")
+    except (OSError, subprocess.CalledProcessError):
+        return "unknown"
+
+
+def p2g_section(R):
+    ns = "ns_per_particle"
+    out = ["## 1. P2G: colored vs serial vs atomic scatter (ns/particle)", "",
+           "Mass, momentum and internal force of one material (the solver's USL transfer). "
+           "2D: 250 000 particles in a 254² grid; 3D: 262 144 particles in a 36³ grid; "
+           "2 particles per cell and direction, sorted by tile. Colored = the solver's scatter "
+           "(tile 8 in 2D, 4 in 3D, the solver defaults). Ratios > 1 mean the colored scatter "
+           "is faster.", ""]
+    header = ["dim", "shape", "real", "serial 1t", "atomic 1t", "atomic 2t", "colored 1t",
+              "colored 2t", "colored 2t/1t speed-up", "serial / colored 2t",
+              "atomic 2t / colored 2t", "colored 1t / serial"]
+    rows = []
+    for dim in ("2", "3"):
+        tile = "8" if dim == "2" else "4"
+        for real in ("double", "float"):
+            for shape in SHAPES:
+                base = dict(dim=dim, shape=shape, real=real)
+                get = lambda strat, th, **kw: R.value("p2g", ns, **base, strategy=strat, threads=th, **kw)
+                s1 = get("serial", 1)
+                a1, a2 = get("atomic", 1), get("atomic", 2)
+                c1, c2 = get("colored", 1, tile=tile), get("colored", 2, tile=tile)
+                if all(v is None for v in (s1, a1, a2, c1, c2)):
+                    continue
+                rows.append([dim + "D", shape, real, fmt(s1), fmt(a1), fmt(a2), fmt(c1), fmt(c2),
+                             ratio(c1, c2), ratio(s1, c2), ratio(a2, c2), ratio(c1, s1)])
+    out.append(table(header, rows))
+    out += ["", "### Tile edge of the colored scatter (ns/particle; best per row in bold)", ""]
+    header = ["dim", "shape", "threads", "T=3", "T=4", "T=8", "T=16"]
+    rows = []
+    for dim in ("2", "3"):
+        for shape in SHAPES:
+            for th in ("1", "2"):
+                vals = [R.value("p2g_tile", ns, dim=dim, shape=shape, real="double", strategy="colored",
+                                tile=t, threads=th) for t in ("3", "4", "8", "16")]
+                if all(v is None for v in vals):
+                    continue
+                best = min((v for v in vals if v is not None), default=None)
+                cells = [("**" + fmt(v) + "**") if v is not None and v == best else fmt(v) for v in vals]
+                rows.append([dim + "D", shape, th] + cells)
+    if rows:
+        out.append(table(header, rows))
+    else:
+        out.append("(no tile sweep in this run)")
+    return out
+
+
+def kernel_section(R):
+    ns = "ns_per_particle"
+    out = ["## 2. G2P and constitutive update (ns/particle)", "",
+           "G2P: FLIP/PIC velocity, position, velocity gradient and the tile-change test, "
+           "as the Stepper runs it. Constitutive: isotropic small-strain update "
+           "(plane strain in 2D). Same particle blocks as P2G.", ""]
+    header = ["kernel", "dim", "shape", "real", "1 thread", "2 threads", "speed-up",
+              "GB/s (2t)"]
+    rows = []
+    for dim in ("2", "3"):
+        for real in ("double", "float"):
+            for shape in SHAPES:
+                v1 = R.value("g2p", ns, dim=dim, shape=shape, real=real, threads=1)
+                v2 = R.value("g2p", ns, dim=dim, shape=shape, real=real, threads=2)
+                gb = R.value("g2p", "particle_GBps", dim=dim, shape=shape, real=real, threads=2)
+                if v1 is None and v2 is None:
+                    continue
+                rows.append(["G2P", dim + "D", shape, real, fmt(v1), fmt(v2), ratio(v1, v2), fmt(gb)])
+            v1 = R.value("constitutive", ns, dim=dim, law="isotropic", real=real, threads=1)
+            v2 = R.value("constitutive", ns, dim=dim, law="isotropic", real=real, threads=2)
+            gb = R.value("constitutive", "particle_GBps", dim=dim, law="isotropic", real=real, threads=2)
+            if v1 is not None or v2 is not None:
+                rows.append(["constitutive", dim + "D", "–", real, fmt(v1), fmt(v2), ratio(v1, v2), fmt(gb)])
+    out.append(table(header, rows))
+    return out
+
+
+STEP_SCENES = [
+    ("2d_linear_1mat", "2D linear, 1 elastic material"),
+    ("2d_gimp_interface", "2D gimp two-layer, imperfect interface (Dn perfect, Dt 5, SN)"),
+    ("3d_gimp_1mat", "3D gimp, 1 elastic material"),
+    ("2d_gimp_1mat", "2D gimp, same geometry, 1 material (baseline)"),
+    ("2d_gimp_2mat_shared", "2D gimp, 2 materials sharing one field"),
+]
+
+
+def step_section(R):
+    ns = "ns_per_particle"
+    out = ["## 3. Whole step through the Simulation interface (ns/particle/step)", "",
+           "make_simulation(parse_scene_text(...)), step() in the loop. Stage columns are the "
+           "Stepper's own timers (1 thread), ns/particle/step.", ""]
+    header = ["scene", "particles", "fields", "1 thread", "2 threads", "speed-up"] + \
+             [s + " (1t)" for s in STAGES]
+    rows = []
+    for scene, label in STEP_SCENES:
+        v1 = R.value("step", ns, scene=scene, threads=1)
+        v2 = R.value("step", ns, scene=scene, threads=2)
+        if v1 is None and v2 is None:
+            continue
+        n = R.value("step", "particles", scene=scene, threads=1) or R.value("step", "particles", scene=scene, threads=2)
+        fields = R.value("step", "fields", scene=scene, threads=1)
+        stages = [fmt(R.value("step", f"stage_{s}_ns_per_particle", scene=scene, threads=1)) for s in STAGES]
+        rows.append([f"`{scene}`: {label}", fmt(n, 0), fmt(fields, 0), fmt(v1), fmt(v2),
+                     ratio(v1, v2)] + stages)
+    out.append(table(header, rows))
+    lin = R.value("step", ns, scene="2d_linear_1mat", threads=1)
+    if lin is not None:
+        verdict = "meets" if lin < 40 else "misses"
+        out += ["", f"Target for 2D linear, one material, one core: < 40 ns/particle/step — "
+                    f"measured {fmt(lin)}: {verdict} the target."]
+    return out
+
+
+def mm_section(R):
+    out = ["## 4. Multimaterial pass (ns per multimaterial node)", "",
+           "find + pass A + pass B, as the solver's multimaterial stage runs them, on a grid "
+           "with one straight interface on a cell midplane (2D: 16×2050 cells, ~4 100 "
+           "multimaterial nodes; 3D: 12×64×64 cells, ~7 900 nodes); gimp P2G of two blocks "
+           "moving into each other and sliding. Interface: Dn perfect, Dt 5, force limit on. "
+           "Manual timer: the momentum restore between iterations is not timed.", ""]
+    header = ["law", "normal", "2D 1t", "2D 2t", "3D 1t", "3D 2t",
+              "2D 1t: find / A / B"]
+    rows = []
+    for law in LAWS:
+        for normal in NORMALS:
+            g = lambda dim, th: R.value("mm", "ns_per_mm_node", dim=dim, law=law, normal=normal,
+                                        real="double", threads=th)
+            vals = [g("2", 1), g("2", 2), g("3", 1), g("3", 2)]
+            if all(v is None for v in vals):
+                continue
+            parts = [R.value("mm", c, dim="2", law=law, normal=normal, real="double", threads=1)
+                     for c in ("find_ns_per_mm_node", "passA_ns_per_mm_node", "passB_ns_per_mm_node")]
+            rows.append([law, normal] + [fmt(v) for v in vals] +
+                        [" / ".join(fmt(p) for p in parts)])
+    out.append(table(header, rows))
+    out += ["", "### Share of a whole step (two-layer scene `2d_gimp_interface`)", ""]
+    header = ["threads", "step ns/particle", "mm stage ns/particle", "share of staged time",
+              "mm nodes", "mm stage ns per mm node (in the step)"]
+    rows = []
+    for th in (1, 2):
+        step = R.value("step", "ns_per_particle", scene="2d_gimp_interface", threads=th)
+        if step is None:
+            continue
+        rows.append([str(th), fmt(step),
+                     fmt(R.value("step", "stage_mm_ns_per_particle", scene="2d_gimp_interface", threads=th), 2),
+                     pct(R.value("step", "mm_share", scene="2d_gimp_interface", threads=th)),
+                     fmt(R.value("step", "mm_nodes", scene="2d_gimp_interface", threads=th), 0),
+                     fmt(R.value("step", "mm_ns_per_mm_node", scene="2d_gimp_interface", threads=th))])
+    out.append(table(header, rows) if rows else "(not in this run)")
+    return out
+
+
+def unused_section(R):
+    ns = "ns_per_particle"
+    out = ["## 5. Unused features cost nothing", "",
+           "Same two-box geometry, supports and traction as the two-layer scene. Median of 3 "
+           "repetitions; cv = their coefficient of variation (the noise).", ""]
+    header = ["threads", "1 material (baseline)", "cv", "2 materials, shared field", "cv",
+              "difference", "with the interface (2 fields + mm pass)"]
+    rows = []
+    for th in (1, 2):
+        a = R.value("step", ns, scene="2d_gimp_1mat", threads=th)
+        b = R.value("step", ns, scene="2d_gimp_2mat_shared", threads=th)
+        if a is None and b is None:
+            continue
+        ca = R.cv("step", ns, scene="2d_gimp_1mat", threads=th)
+        cb = R.cv("step", ns, scene="2d_gimp_2mat_shared", threads=th)
+        diff = "–" if a is None or b is None else f"{100 * (b - a) / a:+.1f} %"
+        c = R.value("step", ns, scene="2d_gimp_interface", threads=th)
+        rows.append([str(th), fmt(a), pct(ca), fmt(b), pct(cb), diff,
+                     fmt(c) + (f" ({ratio(c, a)})" if c is not None and a else "")])
+    out.append(table(header, rows) if rows else "(not in this run)")
+    # Stage breakdown of the pair, 1 thread.
+    rows = []
+    for scene in ("2d_gimp_1mat", "2d_gimp_2mat_shared"):
+        vals = [R.value("step", f"stage_{s}_ns_per_particle", scene=scene, threads=1) for s in STAGES]
+        if all(v is None for v in vals):
+            continue
+        rows.append([f"`{scene}`"] + [fmt(v, 2) for v in vals])
+    if rows:
+        out += ["", "Stage breakdown, 1 thread (ns/particle/step):", "",
+                table(["scene"] + STAGES, rows)]
+    return out
+
+
+def sort_section(R):
+    out = ["## 6. Sort / binning", "",
+           "Stepper::sort_particles for the gimp column set (tile keys, stable counting sort, "
+           "every column permuted through a scratch array, tile ranges). `sorted`: particles "
+           "already in tile order (a re-sort when nothing moved); `random`: a shuffled order.", ""]
+    header = ["dim", "order", "threads", "total ns/particle", "keys", "counting sort", "permute",
+              "ranges", "columns"]
+    rows = []
+    for dim in ("2", "3"):
+        for order in ("sorted", "random"):
+            for th in (1, 2):
+                base = dict(dim=dim, shape="gimp", real="double", order=order, threads=th)
+                tot = R.value("sort", "ns_per_particle", **base)
+                if tot is None:
+                    continue
+                rows.append([dim + "D", order, str(th), fmt(tot)] +
+                            [fmt(R.value("sort", c + "_ns_per_particle", **base), 2)
+                             for c in ("keys", "counting_sort", "permute", "ranges")] +
+                            [fmt(R.value("sort", "columns", **base), 0)])
+    out.append(table(header, rows) if rows else "(not in this run)")
+    out += ["", "### Re-sorting every k steps (2D linear scene, whole step, ns/particle/step)", "",
+            "`sort_every = 0` (the default) re-bins only when a particle changes tile; in this "
+            "scene (small vibrations) that never happens after the first step.", ""]
+    header = ["sort_every", "1 thread", "sort stage (1t)", "2 threads", "sort stage (2t)"]
+    rows = []
+    for every in (None, "1", "10", "100"):
+        kw = {} if every is None else {"sort_every": every}
+        v1 = R.value("step", "ns_per_particle", scene="2d_linear_1mat", threads=1, **kw)
+        v2 = R.value("step", "ns_per_particle", scene="2d_linear_1mat", threads=2, **kw)
+        if v1 is None and v2 is None:
+            continue
+        s1 = R.value("step", "stage_sort_ns_per_particle", scene="2d_linear_1mat", threads=1, **kw)
+        s2 = R.value("step", "stage_sort_ns_per_particle", scene="2d_linear_1mat", threads=2, **kw)
+        rows.append([every or "0 (default)", fmt(v1), fmt(s1, 2), fmt(v2), fmt(s2, 2)])
+    out.append(table(header, rows) if rows else "(not in this run)")
+    return out
+
+
+def main():
+    here = os.path.dirname(os.path.abspath(__file__))
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("json", nargs="?", default=os.path.join(here, "results.json"))
+    ap.add_argument("-o", "--output", default=None, help="Markdown file (default: stdout)")
+    ap.add_argument("--load-after", default=None, help="/proc/loadavg after the run")
+    ap.add_argument("--note", default=None, help="a line added under the header")
+    args = ap.parse_args()
+
+    context, runs, errors = load(args.json)
+    R = Results(runs)
+    model, cpus = lscpu_model()
+    commit = context.get("git_commit") or git_commit(os.path.dirname(here))
+    date = context.get("date") or datetime.datetime.now().isoformat(timespec="seconds")
+    load_avg = context.get("load_avg")
+    lines = ["# mmpm benchmark results", "",
+             "Written by `bench/table.py` from `bench/results.json` (`bench/run`). Do not edit by hand.", "",
+             f"- Date: {date}",
+             f"- Machine: {model}, {cpus} CPU(s) (`lscpu`), {context.get('num_cpus', '?')} seen by "
+             f"the benchmark at {context.get('mhz_per_cpu', '?')} MHz",
+             f"- Git commit: {commit}",
+             f"- Build: Release, -O3 -march=native, MMPM_FAST_DEV={context.get('mmpm_fast_dev', '?')}; "
+             f"Google Benchmark {context.get('library_version', '1.7.1')} "
+             f"(Debian package, itself built as {context.get('library_build_type', '?')})",
+             f"- Load average (1/5/15 min) at start: "
+             f"{' / '.join(f'{x:.2f}' for x in load_avg) if load_avg else context.get('loadavg_before', '?')}"
+             + (f"; after the run: {args.load_after}" if args.load_after else ""),
+             "- Times are wall-clock (UseRealTime, or a manual timer where state is restored "
+             "between iterations). The machine has 2 cores: 2-thread numbers are only meaningful "
+             "when nothing else runs (see the load average)."]
+    if args.note:
+        lines += [f"- Note: {args.note}"]
+    lines.append("")
+    for section in (p2g_section, kernel_section, step_section, mm_section, unused_section,
+                    sort_section):
+        lines += section(R)
+        lines.append("")
+    if errors:
+        lines += ["## Benchmarks that reported an error", ""]
+        lines += [f"- `{n}`: {m}" for n, m in errors]
+        lines.append("")
+    text = "\n".join(lines)
+    if args.output:
+        with open(args.output, "w") as f:
+            f.write(text)
+    else:
+        sys.stdout.write(text)
+
+
+if __name__ == "__main__":
+    main()

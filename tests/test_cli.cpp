@@ -1,0 +1,291 @@
+// The `mmpm` command line through the real binary (MMPM_BINARY): exit codes,
+// the one-line error messages of SCENE.md, what a failed run leaves behind,
+// the summary.json contract, sweeps and --set.
+//
+// Scenes: inputs/bar_vibration.toml (400 particles), shortened with --set
+// simulation.end_time (0.05 ms = 1267 steps, well under a second) or edited
+// line by line for the bad-input cases. Tolerances: stages + other = wall_s
+// and ns_per_particle_step = wall_s 1e9 / (particles steps) to 1e-9
+// relative (both are computed from the same doubles; JSON keeps 17 digits).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <regex>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "io/h5.hpp"
+#include "test_util.hpp"
+
+namespace {
+
+using namespace mmpm_test;
+using nlohmann::json;
+
+std::string bar_scene() { return source_dir() + "/inputs/bar_vibration.toml"; }
+
+// bar_vibration.toml with the line starting with `line_start` replaced by `replacement`.
+std::string edited_bar(const std::string& line_start, const std::string& replacement) {
+  const std::string text = read_text(bar_scene());
+  std::istringstream in(text);
+  std::string out, line;
+  bool done = false;
+  while (std::getline(in, line)) {
+    if (!done && line.rfind(line_start, 0) == 0) {
+      out += replacement + "\n";
+      done = true;
+    } else {
+      out += line + "\n";
+    }
+  }
+  EXPECT_TRUE(done) << "bar_vibration.toml has no line starting with " << line_start;
+  return out;
+}
+
+void expect_no_result(const fs::path& dir) {
+  EXPECT_FALSE(fs::exists(dir / "run.h5")) << dir;
+  EXPECT_FALSE(fs::exists(dir / "summary.json")) << dir;
+  EXPECT_FALSE(fs::exists(dir / "run.xdmf")) << dir;
+}
+
+TEST(Cli, InfoMentionsSimdAndOpenMP) {
+  const CmdResult r = run_mmpm({"info"});
+  ASSERT_EQ(r.exit_code, 0) << r.describe();
+  EXPECT_TRUE(contains(lower(r.out), "simd")) << r.out;
+  EXPECT_TRUE(contains(lower(r.out), "openmp")) << r.out;
+}
+
+TEST(Cli, CheckShippedScene) {
+  const CmdResult r = run_mmpm({"check", bar_scene()});
+  ASSERT_EQ(r.exit_code, 0) << r.describe();
+  EXPECT_TRUE(contains(r.out, "[simulation]")) << "prints the resolved scene";
+  EXPECT_FALSE(contains(lower(r.err), "warning")) << r.err;
+}
+
+TEST(Cli, UsageErrorsExit2) {
+  EXPECT_EQ(run_mmpm({}).exit_code, 2);
+  EXPECT_EQ(run_mmpm({"run", "--bogus"}).exit_code, 2);
+  const CmdResult r = run_mmpm({"run", "/nonexistent/scene.toml"});
+  EXPECT_EQ(r.exit_code, 2) << r.describe();
+  EXPECT_TRUE(contains(r.err, "/nonexistent/scene.toml")) << r.err;
+}
+
+// One bad-input case: the edited scene, the key the message must name and
+// the text on the offending line (to find its number).
+struct BadInput {
+  const char* name;
+  const char* line_start;   // line of bar_vibration.toml to replace
+  const char* replacement;  // new line(s); the first line is the one blamed
+  const char* key;          // dotted key path expected in the message
+  const char* needle;       // text of the blamed line
+};
+
+const BadInput kBadInputs[] = {
+    {"unknown_key", "nu ", "nu      = 0.0\ncolour  = \"red\"", "material[0].colour", "colour"},
+    {"wrong_type", "E ", "E       = \"stiff\"", "material[0].E", "\"stiff\""},
+    {"nu_half", "nu ", "nu      = 0.5", "material[0].nu", "nu      = 0.5"},
+    {"body_outside_grid", "max ", "max      = [40.0, 1.0]", "body[0].max", "[40.0, 1.0]"},
+    {"zero_cell", "cell ", "cell   = [0.0, 0.5]", "grid.cell", "[0.0, 0.5]"},
+    {"missing_material", "material = ", "material = \"unobtainium\"", "body[0].material", "unobtainium"},
+};
+
+class CliBadInput : public ::testing::TestWithParam<BadInput> {};
+
+TEST_P(CliBadInput, Exit2WithOneMessageNamingFileLineKey) {
+  const BadInput& c = GetParam();
+  TempDir tmp(c.name);
+  const fs::path scene = tmp / (std::string(c.name) + ".toml");
+  const std::string text = edited_bar(c.line_start, c.replacement);
+  write_text(scene, text);
+  const int line = line_of(text, c.needle);
+  ASSERT_GT(line, 0);
+  const std::string where = scene.string() + ":" + std::to_string(line) + ":";
+  const std::string key = "'" + std::string(c.key) + "'";
+
+  for (const char* sub : {"check", "run"}) {
+    const fs::path out = tmp / (std::string("out_") + sub);
+    std::vector<std::string> args{sub, scene.string()};
+    if (std::string(sub) == "run") args.insert(args.end(), {"--out", out.string(), "--quiet"});
+    const CmdResult r = run_mmpm(args);
+    EXPECT_EQ(r.exit_code, 2) << sub << "\n" << r.describe();
+    const auto lines = lines_of(r.err);
+    ASSERT_EQ(lines.size(), 1u) << sub << ": exactly one message\n" << r.describe();
+    EXPECT_TRUE(contains(lines[0], where)) << sub << ": names file and line " << where << "\n" << lines[0];
+    EXPECT_TRUE(contains(lines[0], key)) << sub << ": names the key " << key << "\n" << lines[0];
+    EXPECT_TRUE(r.out.empty()) << sub << ": nothing on stdout for bad input\n" << r.out;
+    expect_no_result(out);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Cli, CliBadInput, ::testing::ValuesIn(kBadInputs),
+                         [](const ::testing::TestParamInfo<BadInput>& i) { return std::string(i.param.name); });
+
+TEST(Cli, BadSetValueIsBlamedOnTheSetOption) {
+  TempDir tmp;
+  const CmdResult r = run_mmpm({"run", bar_scene(), "--set", "material[0].nu=0.5", "--out", (tmp / "o").string()});
+  EXPECT_EQ(r.exit_code, 2) << r.describe();
+  const auto lines = lines_of(r.err);
+  ASSERT_EQ(lines.size(), 1u) << r.describe();
+  EXPECT_TRUE(contains(lines[0], "--set material[0].nu")) << lines[0];
+  expect_no_result(tmp / "o");
+}
+
+TEST(Cli, TimeStepAboveStabilityLimit) {
+  TempDir tmp;
+  const std::string scene = bar_scene();
+  // run refuses it: exit 2, one message naming the file and the key, no output.
+  {
+    const CmdResult r = run_mmpm({"run", scene, "--set", "simulation.cfl=1.5", "--out", (tmp / "a").string()});
+    EXPECT_EQ(r.exit_code, 2) << r.describe();
+    const auto lines = lines_of(r.err);
+    ASSERT_EQ(lines.size(), 1u) << r.describe();
+    EXPECT_TRUE(contains(lines[0], "simulation.cfl")) << lines[0];
+    EXPECT_TRUE(contains(lower(lines[0]), "stability")) << lines[0];
+    expect_no_result(tmp / "a");
+  }
+  // An explicit dt above the limit is refused the same way, naming simulation.dt.
+  {
+    const CmdResult r = run_mmpm({"run", scene, "--set", "simulation.dt=1.0e-3", "--out", (tmp / "b").string()});
+    EXPECT_EQ(r.exit_code, 2) << r.describe();
+    EXPECT_TRUE(contains(r.err, "simulation.dt")) << r.err;
+    expect_no_result(tmp / "b");
+  }
+  // --force runs it (3 steps: short enough that the instability stays small).
+  {
+    const CmdResult r = run_mmpm({"run", scene, "--set", "simulation.cfl=1.5", "--set", "simulation.end_time=0.0003",
+                              "--force", "--quiet", "--out", (tmp / "c").string()});
+    EXPECT_EQ(r.exit_code, 0) << r.describe();
+    EXPECT_TRUE(fs::exists(tmp / "c" / "summary.json"));
+  }
+  // check warns (stderr) but succeeds.
+  {
+    const CmdResult r = run_mmpm({"check", scene, "--set", "simulation.cfl=1.5"});
+    EXPECT_EQ(r.exit_code, 0) << r.describe();
+    EXPECT_TRUE(contains(lower(r.err), "warning")) << r.describe();
+    EXPECT_TRUE(contains(r.err, "simulation.cfl")) << r.describe();
+  }
+}
+
+TEST(Cli, UnstableRunNamesStageStepParticleAndLeavesNoResult) {
+  TempDir tmp;
+  const fs::path out = tmp / "out";
+  // A complete result from an earlier run in the same directory must not survive
+  // a failed run there either: it would look like this run's result.
+  const CmdResult ok = run_mmpm({"run", bar_scene(), "--set", "simulation.end_time=0.002", "--quiet", "--out", out.string()});
+  ASSERT_EQ(ok.exit_code, 0) << ok.describe();
+  ASSERT_TRUE(fs::exists(out / "run.h5"));
+  // 2000 mm/ms to the right: the bar reaches the grid edge after ~16 steps.
+  const CmdResult r = run_mmpm({"run", bar_scene(), "--set", "body[0].velocity=[2000.0, 0.0]", "--quiet", "--out",
+                            out.string()});
+  EXPECT_NE(r.exit_code, 0) << r.describe();
+  EXPECT_NE(r.exit_code, 2) << "not an input error: the scene is valid\n" << r.describe();
+  const auto lines = lines_of(r.err);
+  ASSERT_EQ(lines.size(), 1u) << r.describe();
+  EXPECT_TRUE(std::regex_search(lines[0], std::regex(R"(stage [a-z0-9_]+, step [0-9]+, particle [0-9]+)")))
+      << lines[0];
+  expect_no_result(out);
+  EXPECT_FALSE(fs::exists(out / "run.h5.partial"));
+}
+
+double number(const json& j, const char* key) { return j.at(key).get<double>(); }
+
+TEST(Cli, RunWritesResultsAndSummaryContract) {
+  TempDir tmp;
+  const fs::path out = tmp / "bar";
+  const CmdResult r = run_mmpm({"run", bar_scene(), "--set", "simulation.end_time=0.05", "--threads", "2", "--out",
+                            out.string()});
+  ASSERT_EQ(r.exit_code, 0) << r.describe();
+  for (const char* f : {"run.h5", "run.xdmf", "summary.json"}) EXPECT_TRUE(fs::exists(out / f)) << f;
+  EXPECT_FALSE(fs::exists(out / "run.h5.partial"));
+  EXPECT_FALSE(fs::exists(out / "checkpoint.bin"));
+  EXPECT_TRUE(contains(read_text(out / "run.xdmf"), "run.h5"));
+
+  const json j = json::parse(read_text(out / "summary.json"));
+  std::set<std::string> keys;
+  for (const auto& [k, v] : j.items()) keys.insert(k);
+  const std::set<std::string> expected{"scene", "dimension", "precision", "particles", "nodes", "materials",
+                                       "steps", "end_time", "dt", "threads", "wall_s", "ns_per_particle_step",
+                                       "stages_s", "energy", "multimaterial_nodes", "nodes_3plus",
+                                       "force_limited_nodes", "stopped_by"};
+  EXPECT_EQ(keys, expected);
+  std::set<std::string> stage_keys, energy_keys;
+  for (const auto& [k, v] : j.at("stages_s").items()) stage_keys.insert(k);
+  for (const auto& [k, v] : j.at("energy").items()) energy_keys.insert(k);
+  EXPECT_EQ(stage_keys, (std::set<std::string>{"sort", "p2g", "multimaterial", "grid", "g2p", "constitutive",
+                                               "output", "other"}));
+  EXPECT_EQ(energy_keys,
+            (std::set<std::string>{"kinetic", "strain", "interface", "external_work", "damping"}));
+
+  EXPECT_EQ(j.at("scene"), "bar_vibration");
+  EXPECT_EQ(j.at("dimension"), 2);
+  EXPECT_EQ(j.at("precision"), "double");
+  EXPECT_EQ(j.at("particles"), 400);  // 25 x 1 mm at 0.5 mm cells, 2 per cell and direction
+  EXPECT_EQ(j.at("nodes"), 55 * 7);
+  EXPECT_EQ(j.at("materials"), 1);
+  EXPECT_EQ(j.at("threads"), 2);
+  EXPECT_EQ(j.at("stopped_by"), "end_time");
+  EXPECT_EQ(j.at("multimaterial_nodes"), 0);
+
+  // --set reached the run: it stopped at 0.05 ms, not the file's 2.0 ms.
+  const double dt = number(j, "dt"), end = number(j, "end_time");
+  const long steps = j.at("steps").get<long>();
+  EXPECT_GT(dt, 0.0);
+  EXPECT_EQ(steps, long(std::ceil(0.05 / dt - 1e-9)));
+  EXPECT_GE(end, 0.05 - 1e-9 * dt);
+  EXPECT_LT(end, 0.05 + dt);
+  EXPECT_NEAR(end, double(steps) * dt, 1e-9 * end);
+
+  const double wall = number(j, "wall_s");
+  double sum = 0;
+  for (const auto& [k, v] : j.at("stages_s").items()) {
+    sum += v.get<double>();
+    EXPECT_GE(v.get<double>(), 0.0) << k;
+  }
+  EXPECT_GT(wall, 0.0);
+  EXPECT_NEAR(sum, wall, 1e-9 * wall) << "stages + other = wall_s";
+  EXPECT_NEAR(number(j, "ns_per_particle_step"), wall * 1e9 / (400.0 * double(steps)),
+              1e-9 * number(j, "ns_per_particle_step"));
+  EXPECT_GT(number(j.at("energy"), "kinetic"), 0.0);
+  EXPECT_GT(number(j.at("energy"), "strain"), 0.0);
+
+  // run.h5 agrees: the series ends at the summary's step and time; the scene
+  // stored with the results carries the override.
+  using namespace mmpm::io;
+  const h5::File f = h5::File::open(out / "run.h5", h5::File::Mode::read_only);
+  const h5::Group root = f.root();
+  const auto series = root.open_group("series");
+  const auto time = series.open_dataset("time").read_doubles();
+  const auto step = series.open_dataset("step").read_doubles();
+  ASSERT_FALSE(time.empty());
+  EXPECT_EQ(time.back(), end);
+  EXPECT_EQ(step.back(), double(steps));
+  EXPECT_TRUE(contains(root.string_attribute("scene"), "end_time = 0.05")) << root.string_attribute("scene");
+  EXPECT_GE(root.open_group("particles").children().size(), 2u) << "initial and final snapshots";
+}
+
+TEST(Cli, SweepWritesTableAndOneSummaryPerValue) {
+  TempDir tmp;
+  const fs::path out = tmp / "sweep";
+  const CmdResult r = run_mmpm({"sweep", bar_scene(), "--param", "simulation.end_time", "--values", "0.01,0.02", "--jobs",
+                            "2", "--quiet", "--out", out.string()});
+  ASSERT_EQ(r.exit_code, 0) << r.describe();
+  const auto rows = lines_of(read_text(out / "sweep.csv"));
+  ASSERT_EQ(rows.size(), 3u) << "header + 2 rows";
+  EXPECT_TRUE(contains(rows[0], "status"));
+  const double values[2] = {0.01, 0.02};
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_TRUE(contains(rows[std::size_t(k) + 1], ",ok,")) << rows[std::size_t(k) + 1];
+    const fs::path summary = out / std::to_string(k) / "summary.json";
+    ASSERT_TRUE(fs::exists(summary)) << summary;
+    const json j = json::parse(read_text(summary));
+    const double dt = number(j, "dt");
+    EXPECT_GE(number(j, "end_time"), values[k] - 1e-9 * dt) << "value " << k << " reached its run";
+    EXPECT_LT(number(j, "end_time"), values[k] + dt);
+    EXPECT_TRUE(fs::exists(out / std::to_string(k) / "run.h5"));
+  }
+}
+
+}  // namespace

@@ -1,0 +1,301 @@
+// The whole solver (Simulation from make_simulation on a scene text) gives
+// bitwise-identical results on 1 and on 2 OpenMP threads: particle
+// positions, displacements, velocities, stresses and volumes, every energy,
+// the multimaterial counters and the reaction forces after 30 steps.
+//
+// Tolerance: none (memcmp of the values). Resolution: every scene has more
+// than 8192 particles and more than 8192 grid nodes, so that the solver's
+// parallel regions (which switch on at kParallelMin = 8192) really run on 2
+// threads: 2D scenes 110 x 90 cells of 1 mm (10101 nodes) with 12000-14400
+// particles (2 per cell and direction); the 3D scene 24 x 22 x 22 cells
+// (13225 nodes) with 13824 particles. The initial velocity field is
+// non-uniform (so stresses build up at once) and fast enough (~0.5-1 cell in
+// 30 steps) that particles change tiles and the solver re-sorts them.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <cmath>
+#include <cstring>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "scene/parse.hpp"
+#include "solver/simulation.hpp"
+#include "test_util.hpp"
+
+namespace {
+
+using namespace mmpm;
+using mmpm_test::BoxScene2D;
+
+constexpr int kSteps = 30;
+
+struct RunResult {
+  std::string instantiation;
+  std::size_t particles = 0, nodes = 0;
+  std::vector<std::vector<double>> fields;  // kFields order
+  std::vector<double> initial_position;
+  Energies energies;
+  StepCounters counters;
+  std::vector<Reaction> reactions;
+  double time = 0;
+  long steps = 0;
+};
+
+const char* const kFields[] = {"position", "displacement", "velocity", "stress", "volume"};
+
+// A smooth, non-uniform velocity field on top of a drift (mm/ms).
+std::vector<double> velocity_field(const std::vector<double>& x, int dim, double drift) {
+  const std::size_t n = x.size() / std::size_t(dim);
+  std::vector<double> v(x.size());
+  for (std::size_t p = 0; p < n; ++p) {
+    const double* xp = &x[p * std::size_t(dim)];
+    v[p * dim + 0] = drift + 8.0 * std::sin(xp[1] / 5.0);
+    v[p * dim + 1] = 0.5 * drift + 6.0 * std::cos(xp[0] / 7.0);
+    if (dim == 3) v[p * dim + 2] = -0.3 * drift + 5.0 * std::sin((xp[0] + xp[1]) / 6.0);
+  }
+  return v;
+}
+
+RunResult run(const std::string& text, int threads, double drift) {
+  omp_set_num_threads(threads);
+  EXPECT_EQ(omp_get_max_threads(), threads);
+  const Scene scene = parse_scene_text(text, "determinism.toml");
+  std::unique_ptr<Simulation> sim = make_simulation(scene);
+  RunResult r;
+  r.instantiation = sim->instantiation();
+  r.particles = sim->particle_count();
+  r.nodes = sim->node_count();
+  const int dim = scene.simulation.dimension;
+  r.initial_position = sim->particle_field("position").values;
+  sim->set_particle_field("velocity", velocity_field(r.initial_position, dim, drift));
+  for (int s = 0; s < kSteps; ++s) sim->step();
+  for (const char* f : kFields) r.fields.push_back(sim->particle_field(f).values);
+  r.energies = sim->energies();
+  r.counters = sim->counters();
+  r.reactions = sim->reactions();
+  r.time = sim->time();
+  r.steps = sim->step_count();
+  return r;
+}
+
+bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+
+void expect_identical(const RunResult& a, const RunResult& b) {
+  ASSERT_EQ(a.particles, b.particles);
+  ASSERT_EQ(a.fields.size(), b.fields.size());
+  for (std::size_t f = 0; f < a.fields.size(); ++f) {
+    const auto& u = a.fields[f];
+    const auto& v = b.fields[f];
+    ASSERT_EQ(u.size(), v.size()) << kFields[f];
+    std::size_t first = u.size(), count = 0;
+    for (std::size_t i = 0; i < u.size(); ++i)
+      if (!same_bits(u[i], v[i])) {
+        if (first == u.size()) first = i;
+        ++count;
+      }
+    EXPECT_EQ(count, 0u) << kFields[f] << ": " << count << " values differ, first at " << first << ": "
+                         << (first < u.size() ? u[first] : 0.0) << " (1 thread) vs "
+                         << (first < u.size() ? v[first] : 0.0) << " (2 threads)";
+  }
+  const Energies& e = a.energies;
+  const Energies& g = b.energies;
+  EXPECT_TRUE(same_bits(e.kinetic, g.kinetic)) << e.kinetic << " vs " << g.kinetic;
+  EXPECT_TRUE(same_bits(e.strain, g.strain)) << e.strain << " vs " << g.strain;
+  EXPECT_TRUE(same_bits(e.interface, g.interface)) << e.interface << " vs " << g.interface;
+  EXPECT_TRUE(same_bits(e.external_work, g.external_work)) << e.external_work << " vs " << g.external_work;
+  EXPECT_TRUE(same_bits(e.damping, g.damping)) << e.damping << " vs " << g.damping;
+  EXPECT_TRUE(same_bits(e.kinetic_unresolved, g.kinetic_unresolved))
+      << e.kinetic_unresolved << " vs " << g.kinetic_unresolved;
+  EXPECT_EQ(a.counters.multimaterial_nodes, b.counters.multimaterial_nodes);
+  EXPECT_EQ(a.counters.nodes_3plus, b.counters.nodes_3plus);
+  EXPECT_EQ(a.counters.force_limited_nodes, b.counters.force_limited_nodes);
+  ASSERT_EQ(a.reactions.size(), b.reactions.size());
+  for (std::size_t k = 0; k < a.reactions.size(); ++k)
+    for (int d = 0; d < 3; ++d)
+      EXPECT_TRUE(same_bits(a.reactions[k].force[d], b.reactions[k].force[d]))
+          << "reaction " << a.reactions[k].name << " component " << d;
+  EXPECT_TRUE(same_bits(a.time, b.time));
+  EXPECT_EQ(a.steps, b.steps);
+}
+
+// Runs the scene on 1 and on 2 threads and compares; returns the 1-thread run
+// for scene-specific sanity checks (the scene really exercised something).
+RunResult check_scene(const std::string& text, const std::string& instantiation, double drift) {
+  const int saved = omp_get_max_threads();
+  const RunResult one = run(text, 1, drift);
+  const RunResult two = run(text, 2, drift);
+  omp_set_num_threads(saved);
+  EXPECT_EQ(one.instantiation, instantiation);
+  EXPECT_GT(one.particles, 8192u) << "too few particles for the parallel regions to switch on";
+  EXPECT_GT(one.nodes, 8192u) << "too few nodes for the parallel regions to switch on";
+  EXPECT_EQ(one.steps, kSteps);
+  expect_identical(one, two);
+  // Something happened: particles moved by a fair part of a cell, stresses built up.
+  double max_move = 0, max_stress = 0;
+  for (std::size_t i = 0; i < one.fields[0].size(); ++i)
+    max_move = std::max(max_move, std::abs(one.fields[0][i] - one.initial_position[i]));
+  for (double s : one.fields[3]) max_stress = std::max(max_stress, std::abs(s));
+  EXPECT_GT(max_move, 0.3) << "particles should cross cells (and tiles) during the run";
+  EXPECT_GT(max_stress, 0.0);
+  EXPECT_GT(one.energies.strain, 0.0);
+  return one;
+}
+
+// (a) One material, traction on the top face, gravity, a fixed plane.
+BoxScene2D single_material(const std::string& precision) {
+  BoxScene2D s;
+  s.precision = precision;
+  s.b0_min[0] = 4, s.b0_min[1] = 4, s.b0_max[0] = 64, s.b0_max[1] = 54;  // 12000 particles
+  s.extra =
+      "[[boundary]]\nwhere = { y = 4.0 }\nfix = [\"y\"]\n\n"
+      "[[load]]\nkind = \"traction\"\nwhere = { body = \"left\", face = \"y_max\" }\n"
+      "traction = [0.5, -2.0]\nramp = 0.004\n\n"
+      "[[load]]\nkind = \"gravity\"\nacceleration = [0.0, -10.0]\n";
+  return s;
+}
+
+// Two materials side by side (left: a, right: b), 14400 particles, with `interaction`.
+BoxScene2D two_materials(const std::string& precision, const std::string& interaction) {
+  BoxScene2D s;
+  s.precision = precision;
+  s.two_bodies = true;
+  s.second_material = true;
+  s.b0_min[0] = 4, s.b0_min[1] = 4, s.b0_max[0] = 34, s.b0_max[1] = 64;
+  s.b1_min[0] = 34, s.b1_min[1] = 4, s.b1_max[0] = 64, s.b1_max[1] = 64;
+  s.extra = "[[interaction]]\nmaterials = [\"a\", \"b\"]\n" + interaction + "\n";
+  return s;
+}
+
+const char* const kPerfectNormalInterface =
+    "law = \"interface\"\nDn = \"perfect\"\nDt = 5.0\nnormal = \"specified\"\nnormal_vector = [1.0, 0.0]\n";
+const char* const kNumericInterface =
+    "law = \"interface\"\nDn = 200.0\nDt = 5.0\nnormal = \"specified\"\nnormal_vector = [1.0, 0.0]\n";
+const char* const kFrictionContact =
+    "law = \"friction\"\nfriction = 0.3\nseparation = \"position\"\nnormal = \"mvg\"\n";
+
+TEST(Determinism, SingleMaterialGimp2DTractionGravity) {
+  const RunResult r = check_scene(single_material("double").text(), "2D gimp double", 40.0);
+  EXPECT_GT(r.energies.external_work, 0.0);
+  EXPECT_EQ(r.counters.multimaterial_nodes, 0);
+}
+
+TEST(Determinism, SingleMaterialGimp2DFloat) {
+  check_scene(single_material("float").text(), "2D gimp float", 40.0);
+}
+
+TEST(Determinism, SingleMaterialLinear2DUSF) {
+  BoxScene2D s = single_material("double");
+  s.shape = "linear";
+  s.scheme = "USF";
+  check_scene(s.text(), "2D linear double", 40.0);
+}
+
+TEST(Determinism, ImperfectInterfacePerfectNormal2D) {
+  const RunResult r = check_scene(two_materials("double", kPerfectNormalInterface).text(), "2D gimp double", 40.0);
+  EXPECT_GT(r.counters.multimaterial_nodes, 0) << "the multimaterial pass must be active";
+}
+
+TEST(Determinism, ImperfectInterfaceNumericDnMUSL2D) {
+  BoxScene2D s = two_materials("double", kNumericInterface);
+  s.scheme = "MUSL";
+  const RunResult r = check_scene(s.text(), "2D gimp double", 40.0);
+  EXPECT_GT(r.counters.multimaterial_nodes, 0);
+  EXPECT_GT(r.energies.interface, 0.0) << "a compliant interface stores energy once it opens or slides";
+}
+
+TEST(Determinism, ImperfectInterfaceFloat2D) {
+  const RunResult r = check_scene(two_materials("float", kNumericInterface).text(), "2D gimp float", 40.0);
+  EXPECT_GT(r.counters.multimaterial_nodes, 0);
+}
+
+TEST(Determinism, FrictionContactTwoBlocksApproaching2D) {
+  BoxScene2D s = two_materials("double", kFrictionContact);
+  // Leave a gap of one particle spacing less than a cell between the blocks.
+  s.b1_min[0] = 34.5;
+  s.b1_max[0] = 64.5;
+  s.b0_vel[0] = 30.0, s.b0_vel[1] = 10.0;
+  s.b1_vel[0] = -30.0, s.b1_vel[1] = -10.0;
+  // The scene's own body velocities make them approach; drift 0 keeps them.
+  const std::string text = s.text();
+  const int saved = omp_get_max_threads();
+  auto run_contact = [&](int threads) {
+    omp_set_num_threads(threads);
+    const Scene scene = parse_scene_text(text, "contact.toml");
+    auto sim = make_simulation(scene);
+    RunResult r;
+    r.instantiation = sim->instantiation();
+    r.particles = sim->particle_count();
+    r.nodes = sim->node_count();
+    r.initial_position = sim->particle_field("position").values;
+    for (int k = 0; k < kSteps; ++k) sim->step();
+    for (const char* f : kFields) r.fields.push_back(sim->particle_field(f).values);
+    r.energies = sim->energies();
+    r.counters = sim->counters();
+    r.reactions = sim->reactions();
+    r.time = sim->time();
+    r.steps = sim->step_count();
+    return r;
+  };
+  const RunResult one = run_contact(1), two = run_contact(2);
+  omp_set_num_threads(saved);
+  EXPECT_EQ(one.instantiation, "2D gimp double");
+  EXPECT_GT(one.particles, 8192u);
+  EXPECT_GT(one.nodes, 8192u);
+  EXPECT_GT(one.counters.multimaterial_nodes, 0) << "the blocks must be in contact";
+  EXPECT_GT(one.energies.strain, 0.0) << "contact must have stressed the blocks";
+  expect_identical(one, two);
+}
+
+std::string scene_3d() {
+  return R"(
+[simulation]
+dimension = 3
+end_time = 1.0
+cfl = 0.5
+
+[grid]
+origin = [0.0, 0.0, 0.0]
+cell = [1.0, 1.0, 1.0]
+cells = [24, 22, 22]
+shape = "gimp"
+
+[[material]]
+name = "a"
+type = "isotropic"
+density = 1.0e-3
+E = 1000.0
+nu = 0.3
+
+[[body]]
+name = "cube"
+material = "a"
+shape = "box"
+min = [3.0, 3.0, 3.0]
+max = [15.0, 15.0, 15.0]
+particles_per_cell = 2
+
+[[boundary]]
+where = { z = 3.0 }
+fix = ["z"]
+
+[[load]]
+kind = "traction"
+where = { body = "cube", face = "z_max" }
+traction = [0.3, 0.0, -1.5]
+ramp = 0.004
+
+[[load]]
+kind = "gravity"
+acceleration = [0.0, 0.0, -10.0]
+)";
+}
+
+TEST(Determinism, Gimp3DTractionGravity) {
+  const RunResult r = check_scene(scene_3d(), "3D gimp double", 40.0);
+  EXPECT_GT(r.energies.external_work, 0.0);
+}
+
+}  // namespace

@@ -1,0 +1,255 @@
+// `mmpm run --restart DIR` after a SIGKILL continues bitwise where the run
+// left off: every particle snapshot in run.h5 (positions, displacements,
+// velocities, stresses, materials) and every time-series column except the
+// wall-clock stage_*_s timings are bitwise equal to those of an uninterrupted
+// run, and so are the summary's steps, end time and energies.
+//
+// Scene: 2D gimp, two materials joined by a compliant interface (Dn = 300,
+// Dt = 5: interface energy is part of the state), a traction ramp and a
+// fixed face; 44 x 26 cells of 1 mm, 2592 particles, 215 steps, snapshots
+// every 0.01 ms (9), a series row every 10 steps, and checkpoint_minutes =
+// 1e-5 so that a checkpoint is written after almost every step (~2 s wall).
+// All runs use --threads 1 (thread-count independence is test_determinism's
+// job; a loaded 2-core CI machine makes 2-thread runs slow and erratic).
+// Tolerance: none (bitwise).
+#include <gtest/gtest.h>
+#include <signal.h>
+
+#include <chrono>
+#include <cstring>
+#include <sstream>
+#include <map>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "io/checkpoint.hpp"
+#include "io/h5.hpp"
+#include "test_util.hpp"
+
+namespace {
+
+using namespace mmpm_test;
+using nlohmann::json;
+
+const char* const kScene = R"(# restart test scene (tests/test_restart.cpp)
+[simulation]
+dimension = 2
+plane = "strain"
+end_time = 0.08
+cfl = 0.5
+
+[grid]
+origin = [0.0, 0.0]
+cell = [1.0, 1.0]
+cells = [44, 26]
+shape = "gimp"
+
+[[material]]
+name = "a"
+type = "isotropic"
+density = 1.0e-3
+E = 1000.0
+nu = 0.3
+
+[[material]]
+name = "b"
+type = "isotropic"
+density = 2.0e-3
+E = 3000.0
+nu = 0.25
+
+[[body]]
+name = "left"
+material = "a"
+shape = "box"
+min = [4.0, 4.0]
+max = [22.0, 22.0]
+particles_per_cell = 2
+velocity = [0.0, 2.0]
+
+[[body]]
+name = "right"
+material = "b"
+shape = "box"
+min = [22.0, 4.0]
+max = [40.0, 22.0]
+particles_per_cell = 2
+velocity = [0.0, -2.0]
+
+[[interaction]]
+materials = ["a", "b"]
+law = "interface"
+Dn = 300.0
+Dt = 5.0
+normal = "specified"
+normal_vector = [1.0, 0.0]
+
+[[boundary]]
+where = "y_min"
+fix = ["y"]
+
+[[load]]
+kind = "traction"
+where = { body = "right", face = "x_max" }
+traction = [1.0, 0.0]
+ramp = 0.02
+
+[output]
+every = 0.01
+series = 10
+checkpoint_minutes = 1.0e-5
+fields = ["displacement", "velocity", "stress", "material"]
+)";
+
+// Everything run.h5 holds that a restart must reproduce.
+struct RunFile {
+  // snapshot group name -> dataset name -> values; plus the time/step attributes.
+  std::map<std::string, std::map<std::string, std::vector<double>>> snapshots;
+  std::map<std::string, std::pair<double, std::int64_t>> snapshot_time_step;
+  std::vector<std::string> columns;
+  std::map<std::string, std::vector<double>> series;
+};
+
+RunFile read_run(const fs::path& file) {
+  using namespace mmpm::io;
+  RunFile r;
+  const h5::File f = h5::File::open(file, h5::File::Mode::read_only);
+  const h5::Group root = f.root();
+  const h5::Group particles = root.open_group("particles");
+  for (const std::string& name : particles.children()) {
+    const h5::Group g = particles.open_group(name);
+    r.snapshot_time_step[name] = {g.double_attribute("time"), g.int_attribute("step")};
+    for (const std::string& ds : g.children()) r.snapshots[name][ds] = g.open_dataset(ds).read_doubles();
+  }
+  const h5::Group series = root.open_group("series");
+  std::string list = series.string_attribute("columns");
+  std::stringstream in(list);
+  for (std::string c; std::getline(in, c, ',');) {
+    r.columns.push_back(c);
+    r.series[c] = series.open_dataset(c).read_doubles();
+  }
+  return r;
+}
+
+bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+}
+
+std::string first_diff(const std::vector<double>& a, const std::vector<double>& b) {
+  if (a.size() != b.size()) return "sizes " + std::to_string(a.size()) + " vs " + std::to_string(b.size());
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (std::memcmp(&a[i], &b[i], sizeof(double)) != 0) {
+      std::ostringstream s;
+      s.precision(17);
+      s << "entry " << i << ": " << a[i] << " vs " << b[i];
+      return s.str();
+    }
+  return "none";
+}
+
+void expect_same_run(const RunFile& ref, const RunFile& got) {
+  // Snapshots: the same steps, each bitwise equal.
+  std::vector<std::string> a, b;
+  for (const auto& [k, v] : ref.snapshots) a.push_back(k);
+  for (const auto& [k, v] : got.snapshots) b.push_back(k);
+  EXPECT_EQ(a, b) << "snapshot steps";
+  EXPECT_GE(a.size(), 5u) << "the scene should write several snapshots";
+  for (const auto& [name, datasets] : ref.snapshots) {
+    if (!got.snapshots.count(name)) continue;
+    const auto& other = got.snapshots.at(name);
+    EXPECT_EQ(ref.snapshot_time_step.at(name), got.snapshot_time_step.at(name)) << name;
+    for (const char* required : {"position", "velocity", "stress", "displacement"})
+      EXPECT_TRUE(datasets.count(required)) << name << " lacks " << required;
+    for (const auto& [ds, values] : datasets) {
+      ASSERT_TRUE(other.count(ds)) << name << "/" << ds << " missing after restart";
+      EXPECT_TRUE(same_bits(values, other.at(ds))) << name << "/" << ds << " differs: " << first_diff(values, other.at(ds));
+    }
+  }
+  // Series: same columns; all but the wall-clock timings bitwise equal.
+  EXPECT_EQ(ref.columns, got.columns);
+  int compared = 0;
+  for (const auto& c : ref.columns) {
+    if (c.rfind("stage_", 0) == 0) continue;
+    if (!got.series.count(c)) continue;
+    EXPECT_TRUE(same_bits(ref.series.at(c), got.series.at(c))) << "series " << c << ": "
+                                                               << first_diff(ref.series.at(c), got.series.at(c));
+    ++compared;
+  }
+  for (const char* c : {"time", "step", "kinetic", "strain", "interface", "external_work", "damping"})
+    EXPECT_TRUE(ref.series.count(c)) << "series column " << c;
+  EXPECT_GE(compared, 7);
+}
+
+TEST(Restart, KilledRunContinuesBitwise) {
+  TempDir tmp;
+  const fs::path scene = tmp / "restart_scene.toml";
+  write_text(scene, kScene);
+
+  // 1. The uninterrupted run.
+  const fs::path ref_dir = tmp / "ref";
+  const CmdResult ref = run_mmpm({"run", scene.string(), "--out", ref_dir.string(), "--threads", "1", "--quiet"});
+  ASSERT_EQ(ref.exit_code, 0) << ref.describe();
+  const json ref_summary = json::parse(read_text(ref_dir / "summary.json"));
+  const long steps = ref_summary.at("steps").get<long>();
+  ASSERT_GT(steps, 100);
+  EXPECT_FALSE(fs::exists(ref_dir / "checkpoint.bin")) << "a completed run removes its checkpoint";
+
+  // 2. The same run, killed part-way (after its first checkpoint). If the
+  // machine is so fast the run ends first, try again killing earlier.
+  const fs::path dir = tmp / "killed";
+  bool killed = false;
+  for (double fraction : {0.4, 0.2, 0.08, 0.0}) {
+    fs::remove_all(dir);
+    Child child({mmpm_binary(), "run", scene.string(), "--out", dir.string(), "--threads", "1", "--quiet"},
+                tmp / "killed.out", tmp / "killed.err");
+    const auto t0 = std::chrono::steady_clock::now();
+    while (!child.poll_done()) {
+      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      if (fs::exists(dir / "checkpoint.bin") && elapsed >= fraction * ref.seconds) {
+        child.kill_and_wait(SIGKILL);
+        killed = child.result().signal == SIGKILL;
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    if (killed) break;
+    ASSERT_EQ(child.result().exit_code, 0) << "the run to be killed failed by itself: "
+                                           << read_text(tmp / "killed.err");
+  }
+  ASSERT_TRUE(killed) << "could not kill the run before it finished";
+  EXPECT_TRUE(fs::exists(dir / "checkpoint.bin"));
+  EXPECT_FALSE(fs::exists(dir / "run.h5")) << "a killed run must not look finished";
+  EXPECT_FALSE(fs::exists(dir / "summary.json")) << "a killed run must not look finished";
+  EXPECT_TRUE(fs::exists(dir / "run.h5.partial"));
+
+  // The checkpoint is from part-way through the run.
+  const auto blobs = mmpm::io::read_checkpoint(dir / "checkpoint.bin");
+  const long ckpt_step = mmpm::io::read_scalar_blob<long>(mmpm::io::find_blob(blobs, "step"));
+  EXPECT_GT(ckpt_step, 0);
+  EXPECT_LT(ckpt_step, steps);
+
+  // 3. Restart and compare.
+  const CmdResult again = run_mmpm({"run", "--restart", dir.string(), "--threads", "1", "--quiet"});
+  ASSERT_EQ(again.exit_code, 0) << again.describe();
+  ASSERT_TRUE(fs::exists(dir / "run.h5"));
+  ASSERT_TRUE(fs::exists(dir / "summary.json"));
+  EXPECT_TRUE(fs::exists(dir / "run.xdmf"));
+  EXPECT_FALSE(fs::exists(dir / "run.h5.partial"));
+  EXPECT_FALSE(fs::exists(dir / "checkpoint.bin"));
+
+  expect_same_run(read_run(ref_dir / "run.h5"), read_run(dir / "run.h5"));
+
+  const json got = json::parse(read_text(dir / "summary.json"));
+  EXPECT_EQ(got.at("steps"), ref_summary.at("steps"));
+  EXPECT_EQ(got.at("end_time").get<double>(), ref_summary.at("end_time").get<double>());
+  EXPECT_EQ(got.at("particles"), ref_summary.at("particles"));
+  for (const char* e : {"kinetic", "strain", "interface", "external_work", "damping"})
+    EXPECT_EQ(got.at("energy").at(e).get<double>(), ref_summary.at("energy").at(e).get<double>()) << e;
+  EXPECT_EQ(got.at("multimaterial_nodes"), ref_summary.at("multimaterial_nodes"));
+  EXPECT_GT(ref_summary.at("energy").at("interface").get<double>(), 0.0) << "the interface carries state";
+}
+
+}  // namespace
