@@ -19,6 +19,7 @@ STAGES = ["sort", "p2g", "mm", "grid", "g2p", "constitutive"]
 SHAPES = ["linear", "gimp", "bspline2", "bspline3"]
 LAWS = ["stick", "frictionless", "friction", "interface"]
 NORMALS = ["mvg", "avg", "specified", "radial"]
+NOTES_MARKER = "<!-- notes: everything below this line is kept when table.py rewrites the file -->"
 
 
 def parse_name(name):
@@ -370,7 +371,9 @@ def main():
     date = context.get("date") or datetime.datetime.now().isoformat(timespec="seconds")
     load_avg = context.get("load_avg")
     lines = ["# mmpm benchmark results", "",
-             "Written by `bench/table.py` from `bench/results.json` (`bench/run`). Do not edit by hand.", "",
+             "Tables written by `bench/table.py` from `bench/results.json`; reproduce with "
+             "`bench/run` (full, ~3-5 min) or `bench/run --quick` (subset, results on stdout). "
+             "Only the notes at the end are hand-written.", "",
              f"- Date: {date}",
              f"- Machine: {model}, {cpus} CPU(s) (`lscpu`), {context.get('num_cpus', '?')} seen by "
              f"the benchmark at {context.get('mhz_per_cpu', '?')} MHz",
@@ -397,6 +400,13 @@ def main():
         lines.append("")
     text = "\n".join(lines)
     if args.output:
+        # Hand-written notes after the marker survive a regeneration.
+        if os.path.exists(args.output):
+            with open(args.output) as f:
+                old = f.read()
+            at = old.find(NOTES_MARKER)
+            if at >= 0:
+                text = text.rstrip("\n") + "\n\n" + old[at:]
         with open(args.output, "w") as f:
             f.write(text)
     else:

@@ -80,17 +80,18 @@ G2PRangeResult g2p_range(const ParticleView<D, Real>& P, const GridView<D, Real>
       bool finite = true;
       double work = 0;
       for (int d = 0; d < D; ++d) {
-        const Real vold = P.v[d][p];
-        const Real vnew = flip * (vold + dv[d]) + pic * vn[d];
+        const Real vnew = flip * (P.v[d][p] + dv[d]) + pic * vn[d];
         P.v[d][p] = vnew;
         if (P.x_next[0])
           P.x_next[d][p] = P.x[d][p] + dt * vn[d];
         else
           P.x[d][p] += dt * vn[d];
         finite = finite && std::isfinite(vnew);
-        const double vmid = 0.5 * (double(vold) + double(vnew));
-        if constexpr (Traction) work += double(P.fext[d][p]) * vmid;
-        if constexpr (Gravity) work += double(P.m[p]) * q.body_accel[d] * vmid;
+        // Work = force times the displacement of the material point, which
+        // moves with the grid velocity (not with its FLIP velocity).
+        const double vmove = double(vn[d]);
+        if constexpr (Traction) work += double(P.fext[d][p]) * vmove;
+        if constexpr (Gravity) work += double(P.m[p]) * q.body_accel[d] * vmove;
       }
       if constexpr (Traction || Gravity) r.external_work += work * q.dt;
       if (!finite && r.bad == SIZE_MAX) r.bad = p;

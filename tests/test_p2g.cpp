@@ -23,8 +23,9 @@
 //    only needs the fixed color order, which is what is checked bitwise.)
 //  - Tiles of one color never touch a common node (checked node by node, so
 //    a coloring bug fails deterministically rather than by a lucky race).
-// Resolution: 2D grid 37 x 29 cells, 6000 particles; 3D 13 x 11 x 9 cells,
-// 4000 particles; cells of unequal size; tile edges 3 (the minimum) and 8.
+// Resolution: 2D grid 37 x 29 cells, 6000 particles; 3D 13 x 12 x 11 cells,
+// 4000 particles; cells of unequal size; tile edges 4 (the minimum: TileLayout
+// rounds the edge up to a power of two >= 4), 8 and 16.
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -152,7 +153,7 @@ struct Grid {
 
 template <int D>
 std::array<int, 3> grid_cells() {
-  return D == 2 ? std::array<int, 3>{37, 29, 1} : std::array<int, 3>{13, 11, 9};
+  return D == 2 ? std::array<int, 3>{37, 29, 1} : std::array<int, 3>{13, 12, 11};
 }
 
 // Random particles at least 2 cells inside the grid (bspline3 needs that), in
@@ -214,7 +215,7 @@ template <int D>
 TileRanges tile_ranges(const std::vector<std::uint32_t>& sorted_keys, const TileLayout<D>& tiles) {
   TileRanges r;
   r.begin.assign(std::size_t(tiles.tile_count) + 1, 0);
-  for (std::uint32_t k : sorted_keys) ++r.begin[k / tiles.keys_per_tile + 1];
+  for (std::uint32_t k : sorted_keys) ++r.begin[tiles.tile_of_key(k) + 1];
   for (std::uint32_t t = 0; t < tiles.tile_count; ++t) r.begin[t + 1] += r.begin[t];
   for (std::uint32_t t = 0; t < tiles.tile_count; ++t)
     if (r.begin[t + 1] > r.begin[t]) r.color[std::size_t(tiles.color(t))].push_back(t);
@@ -357,12 +358,13 @@ TYPED_TEST(P2G, SameColorTilesTouchDisjointNodes) {
   using Shape = typename TypeParam::Shape;
   using Real = typename TypeParam::Real;
   const bool gimp = std::string(Shape::name) == "gimp";
-  for (int T : {3, 4, 8}) {
+  for (int T : {4, 8, 16}) {
     Grid<D, Real> g(grid_cells<D>(), 1);
     auto p = random_particles<D, Real>(g.G, g.cells, D == 2 ? 6000 : 4000, 200 + unsigned(T));
     for (int d = 0; d < D; ++d) std::fill(p.lp[d].begin(), p.lp[d].end(), Real(0.5));  // widest uGIMP
     TileLayout<D> tiles;
     tiles.setup(T, g.cells);
+    ASSERT_EQ(tiles.T, T);
     auto sorted = p.permuted(sort_by_tile(p, g.G, tiles));
     const auto P = sorted.view(gimp);
     const std::array<Real, 3> inv_h{Real(1) / g.G.h[0], Real(1) / g.G.h[1], Real(1) / g.G.h[2]};
@@ -370,7 +372,7 @@ TYPED_TEST(P2G, SameColorTilesTouchDisjointNodes) {
     for (int color = 0; color < (1 << D); ++color) {
       std::fill(owner.begin(), owner.end(), -1);
       for (std::size_t i = 0; i < sorted.n; ++i) {
-        const std::uint32_t tile = sorted.key[i] / tiles.keys_per_tile;
+        const std::uint32_t tile = tiles.tile_of_key(sorted.key[i]);
         if (tiles.color(tile) != color) continue;
         Stencil<D, Shape, Real> st;
         ASSERT_TRUE(st.build(P, g.G, inv_h, i));
@@ -406,6 +408,7 @@ void check_colored(int T, unsigned seed) {
 
   TileLayout<D> tiles;
   tiles.setup(T, natural.cells);
+  ASSERT_EQ(tiles.T, T) << "tile edges are powers of two";
   auto sorted = p.permuted(sort_by_tile(p, natural.G, tiles));
   for (std::size_t i = 1; i < n; ++i) ASSERT_LE(sorted.key[i - 1], sorted.key[i]) << "sorted by key";
   const auto P = sorted.view(gimp);
@@ -447,13 +450,13 @@ void check_colored(int T, unsigned seed) {
   }
 }
 
-TYPED_TEST(P2G, ColoredScatterMatchesSerialMultiFieldTile3) {
-  check_colored<TypeParam::D, typename TypeParam::Shape, typename TypeParam::Real, true, true>(3, 301);
+TYPED_TEST(P2G, ColoredScatterMatchesSerialMultiFieldTile4) {
+  check_colored<TypeParam::D, typename TypeParam::Shape, typename TypeParam::Real, true, true>(4, 301);
 }
-TYPED_TEST(P2G, ColoredScatterMatchesSerialSingleFieldTile4) {
-  check_colored<TypeParam::D, typename TypeParam::Shape, typename TypeParam::Real, false, false>(4, 302);
+TYPED_TEST(P2G, ColoredScatterMatchesSerialSingleFieldTile8) {
+  check_colored<TypeParam::D, typename TypeParam::Shape, typename TypeParam::Real, false, false>(8, 302);
 }
-TYPED_TEST(P2G, ColoredScatterMatchesSerialMultiFieldTile8) {
+TYPED_TEST(P2G, ColoredScatterMatchesSerialMultiFieldNoTraction) {
   check_colored<TypeParam::D, typename TypeParam::Shape, typename TypeParam::Real, true, false>(TypeParam::D == 2 ? 8 : 4, 303);
 }
 

@@ -543,7 +543,7 @@ TEST(SceneParseValid, DefaultsAreFilled) {
   EXPECT_DOUBLE_EQ(sim.thickness, 1.0);
   EXPECT_DOUBLE_EQ(sim.cfl, 0.5);
   EXPECT_FALSE(sim.dt.has_value());
-  EXPECT_EQ(sim.scheme, Scheme::USL);
+  EXPECT_EQ(sim.scheme, Scheme::MUSL);
   EXPECT_DOUBLE_EQ(sim.flip, 1.0);
   EXPECT_EQ(sim.precision, Precision::float64);
   EXPECT_EQ(sim.default_law, Law::stick);
@@ -638,7 +638,7 @@ TEST(SceneParseFormat, ShowsDefaultsAndKeepsExactNumbers) {
   const Scene s = parse_scene_text(kBase, "base.toml");
   const std::string text = format_scene(s);
   for (const char* line :
-       {"shape = \"gimp\"", "cfl = 0.5", "scheme = \"USL\"", "density = 0.001", "Dn = \"perfect\"",
+       {"shape = \"gimp\"", "cfl = 0.5", "scheme = \"MUSL\"", "density = 0.001", "Dn = \"perfect\"",
         "Dt = 5.0", "cells = [20, 20]", "where = \"y_min\"",
         "where = { body = \"left\", face = \"y_max\" }", "directory = \"results/base\"",
         "enabled = false", "particles_per_cell = 2"}) {

@@ -28,6 +28,7 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
 const char* kAxes[3] = {"x", "y", "z"};
+constexpr std::size_t kResidualWindow = 10;  // series rows
 
 // State of the driver that a checkpoint must carry besides the simulation's.
 struct DriverState {
@@ -47,7 +48,8 @@ std::string sanitize(std::string s) {
 
 std::vector<std::string> series_names(const Simulation& sim) {
   std::vector<std::string> n = {"time",     "step",          "kinetic", "strain", "interface",
-                                "external_work", "damping",  "kinetic_unresolved", "energy_balance"};
+                                "external_work", "damping",  "kinetic_unresolved", "energy_balance",
+                                "kinetic_ratio", "stored_energy_residual"};
   const int dim = sim.snapshot({}).dimension;
   for (const auto& r : sim.reactions())
     for (int d = 0; d < dim; ++d) n.push_back(sanitize("reaction_" + r.name + "_" + kAxes[d]));
@@ -67,6 +69,16 @@ void add_series_row(Simulation& sim, DriverState& st, const std::array<double, k
   std::vector<double> row = {sim.time(), double(sim.step_count()), e.kinetic, e.strain, e.interface,
                              e.external_work, e.damping, e.kinetic_unresolved,
                              total - e.external_work - initial};
+  // Convergence monitor for static runs: kinetic / stored energy, and the
+  // relative change of the stored energy over the last kResidualWindow rows.
+  const double stored = e.strain + e.interface;
+  row.push_back(stored > 0 ? e.kinetic / stored : (e.kinetic > 0 ? INFINITY : 0.0));
+  double residual = INFINITY;
+  if (!st.columns.empty() && st.columns[0].size() >= kResidualWindow && stored > 0) {
+    const std::size_t k = st.columns[0].size() - kResidualWindow;
+    residual = std::abs(stored - (st.columns[3][k] + st.columns[4][k])) / stored;
+  }
+  row.push_back(residual);
   for (const auto& r : sim.reactions())
     for (int d = 0; d < dim; ++d) row.push_back(r.force[d]);
   const StepCounters c = sim.counters();

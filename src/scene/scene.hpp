@@ -41,7 +41,9 @@ struct SimulationSpec {
   double end_time = 0.0;
   double cfl = 0.5;
   std::optional<double> dt;  // explicit time step overrides cfl
-  Scheme scheme = Scheme::USL;
+  // MUSL by default: USL takes the strain rate from p/m of nodes that may
+  // hold a sliver of mass (cell crossing, uGIMP edges) and is unstable there.
+  Scheme scheme = Scheme::MUSL;
   double flip = 1.0;
   Precision precision = Precision::float64;
   Law default_law = Law::stick;
