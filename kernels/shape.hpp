@@ -25,35 +25,35 @@ struct LinearShape {
 };
 
 // uGIMP (Bardenhagen & Kober 2004) with a constant particle half-width l
-// (cell units, l = 1/(2 ppc) ≤ 1/2). Three nodes suffice: the node
+// (cell units, l = 1/(2 ppc) <= 1/2). Three nodes suffice: the node
 // base - 1 or base + 2 can only be reached when l > 1/2.
+// The weight is the hat function averaged over the particle domain,
+// S(d) = (H(d + l) - H(d - l)) / (2l) with H the hat's antiderivative, and
+// dS/dd = (hat(d + l) - hat(d - l)) / (2l). With c = clamp(s, -1, 1),
+// H(s) = 1/2 + c - c|c|/2 and hat(s) = 1 - |c|: no branches, so the
+// stencil evaluation does not mispredict as particles move.
 struct GimpShape {
   static constexpr int S = 3;
   static constexpr const char* name = "gimp";
   template <class Real>
+  static Real clamp1(Real s) {
+    return s < Real(-1) ? Real(-1) : (s > Real(1) ? Real(1) : s);
+  }
+  template <class Real>
   static void node(Real d, Real l, Real& w, Real& dw) {
-    const Real a = std::abs(d);
-    const Real sgn = d < 0 ? Real(-1) : Real(1);
-    if (a < l) {
-      w = Real(1) - (d * d + l * l) / (Real(2) * l);
-      dw = -d / l;
-    } else if (a < Real(1) - l) {
-      w = Real(1) - a;
-      dw = -sgn;
-    } else if (a < Real(1) + l) {
-      const Real q = Real(1) + l - a;
-      w = q * q / (Real(4) * l);
-      dw = -sgn * q / (Real(2) * l);
-    } else {
-      w = Real(0);
-      dw = Real(0);
-    }
+    const Real inv2l = Real(0.5) / l;
+    const Real a = clamp1(d + l), b = clamp1(d - l);
+    const Real Ha = Real(0.5) + a - Real(0.5) * a * std::abs(a);
+    const Real Hb = Real(0.5) + b - Real(0.5) * b * std::abs(b);
+    w = (Ha - Hb) * inv2l;
+    dw = (std::abs(b) - std::abs(a)) * inv2l;  // hat(d + l) - hat(d - l), over 2l
   }
   template <class Real>
   static int eval(Real xi, Real l, Real* w, Real* dw) {
-    const int base = int(std::floor(xi - Real(0.5)));
-    for (int k = 0; k < 3; ++k) node(xi - Real(base + k), l, w[k], dw[k]);
-    return base;
+    const Real fb = std::floor(xi - Real(0.5));
+    const Real r = xi - fb;
+    for (int k = 0; k < 3; ++k) node(r - Real(k), l, w[k], dw[k]);
+    return int(fb);
   }
 };
 
@@ -76,27 +76,29 @@ struct BSpline2Shape {
   }
 };
 
-// Cubic B-spline: four nodes.
+// Cubic B-spline: four nodes. With r = xi - base in [1, 2) the distances
+// to the nodes are r, r-1, r-2, r-3: the first and last always fall in the
+// outer piece (1 <= |d| < 2), the middle two in the inner piece, so the
+// weights need no branches.
 struct BSpline3Shape {
   static constexpr int S = 4;
   static constexpr const char* name = "bspline3";
   template <class Real>
   static int eval(Real xi, Real /*half_width*/, Real* w, Real* dw) {
     const Real fb = std::floor(xi) - Real(1);
-    const Real r = xi - fb;  // in [1, 2): distances r, r-1, r-2, r-3
-    for (int k = 0; k < 4; ++k) {
-      const Real d = r - Real(k);
-      const Real a = std::abs(d);
-      const Real sgn = d < 0 ? Real(-1) : Real(1);
-      if (a < Real(1)) {
-        w[k] = Real(2) / Real(3) - a * a + Real(0.5) * a * a * a;
-        dw[k] = sgn * (Real(-2) * a + Real(1.5) * a * a);
-      } else {
-        const Real q = Real(2) - a;
-        w[k] = q * q * q / Real(6);
-        dw[k] = -sgn * Real(0.5) * q * q;
-      }
-    }
+    const Real r = xi - fb;                   // in [1, 2)
+    const Real q0 = Real(2) - r;              // outer piece, d = r
+    const Real a1 = r - Real(1);              // inner piece, d = r - 1 >= 0
+    const Real a2 = Real(2) - r;              // inner piece, d = r - 2 < 0, |d| = 2 - r
+    const Real q3 = r - Real(1);              // outer piece, d = r - 3, 2 - |d| = r - 1
+    w[0] = q0 * q0 * q0 / Real(6);
+    dw[0] = Real(-0.5) * q0 * q0;
+    w[1] = Real(2) / Real(3) - a1 * a1 + Real(0.5) * a1 * a1 * a1;
+    dw[1] = Real(-2) * a1 + Real(1.5) * a1 * a1;
+    w[2] = Real(2) / Real(3) - a2 * a2 + Real(0.5) * a2 * a2 * a2;
+    dw[2] = Real(2) * a2 - Real(1.5) * a2 * a2;
+    w[3] = q3 * q3 * q3 / Real(6);
+    dw[3] = Real(0.5) * q3 * q3;
     return int(fb);
   }
 };

@@ -36,8 +36,8 @@ TEST(ContactExplore, Collision) {
     maxerr = std::max(maxerr, std::abs(P - P0) / std::abs(P0));
     const auto e = sim->energies();
     if (k % 10 == 0 || std::getenv("ALL"))
-      printf("t %.4f vA %.5f vB %.5f  Perr %.3e Py %.2e KE %.5f SE %.5f gapAB %.4f mm %ld\n", sim->time(), b[0].px / b[0].m, b[1].px / b[1].m,
-             (P - P0) / P0, Py, e.kinetic, e.strain, b[1].minx - b[0].maxx, sim->counters().multimaterial_nodes);
+      printf("t %.4f vA %.5f vB %.5f  Perr %.3e Py %.2e KE %.5f SE %.5f TOT %.5f gapAB %.4f mm %ld\n", sim->time(), b[0].px / b[0].m, b[1].px / b[1].m,
+             (P - P0) / P0, Py, e.kinetic, e.strain, e.kinetic + e.strain, b[1].minx - b[0].maxx, sim->counters().multimaterial_nodes);
     sim->step();
     ++k;
   }

@@ -30,7 +30,11 @@ std::string build_description() {
   unsigned maj = 0, min = 0, rel = 0;
   H5get_libversion(&maj, &min, &rel);
   os << "hdf5: " << maj << "." << min << "." << rel << "\n";
+#ifdef MMPM_FAST_DEV
+  os << "instantiations: 2D linear double, 2D gimp double/float, 3D gimp double (MMPM_FAST_DEV build)\n";
+#else
   os << "instantiations: dimension {2,3} x shape {linear, gimp, bspline2, bspline3} x precision {double, float}\n";
+#endif
   return os.str();
 }
 

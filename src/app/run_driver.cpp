@@ -151,11 +151,12 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
   const double crit = critical_time_step(scene);
   const double dt = stable_time_step(scene);
   if (dt > crit * (1 + 1e-12) && !(opt.force || scene.simulation.force)) {
+    const Where& w = scene.simulation.step_where;
     std::ostringstream m;
-    m << scene.source_file << ": key 'simulation." << (scene.simulation.dt ? "dt" : "cfl")
-      << "': time step " << dt << " exceeds the stability limit " << crit
-      << " (cfl " << dt / crit << " > 1); lower it, or run with --force";
-    throw InputError(m.str());
+    m << "time step " << dt << " exceeds the stability limit " << crit << " (cfl " << dt / crit
+      << " > 1); lower it, or run with --force";
+    throw InputError(located(w.file.empty() ? scene.source_file : w.file, w.line,
+                             w.key.empty() ? "simulation.cfl" : w.key, m.str()));
   }
   std::unique_ptr<Simulation> sim = make_simulation(scene);
   const int dim = scene.simulation.dimension;

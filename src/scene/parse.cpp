@@ -159,6 +159,10 @@ class Field {
       : v_(&v), path_(std::move(path)), src_(&src) {}
 
   const toml::value& raw() const { return *v_; }
+  Where where() const {
+    const Place p = src_->place(*v_);
+    return Where{p.file, p.line, path_};
+  }
 
   [[noreturn]] void fail(const std::string& what) const {
     const Place p = src_->place(*v_);
@@ -550,8 +554,15 @@ class SceneReader {
     if (auto f = t.get("plane")) sim.plane = f->choice(kPlaneNames);
     if (auto f = t.get("thickness")) sim.thickness = f->positive();
     sim.end_time = t.need("end_time").positive();
-    if (auto f = t.get("cfl")) sim.cfl = f->positive();
-    if (auto f = t.get("dt")) sim.dt = f->positive();
+    sim.step_where = Where{src_.label(), 0, "simulation.cfl"};
+    if (auto f = t.get("cfl")) {
+      sim.cfl = f->positive();
+      sim.step_where = f->where();
+    }
+    if (auto f = t.get("dt")) {
+      sim.dt = f->positive();
+      sim.step_where = f->where();
+    }
     if (auto f = t.get("scheme")) sim.scheme = f->choice(kSchemeNames);
     if (auto f = t.get("flip")) {
       sim.flip = f->number();

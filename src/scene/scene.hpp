@@ -49,6 +49,7 @@ struct SimulationSpec {
   Law default_law = Law::stick;
   bool force = false;  // run even when dt exceeds the stability limit
   int sort_every = 0;  // 0 = re-bin only when a particle changes tile
+  Where step_where;    // where the time step was set (cfl or dt), for messages
 };
 
 struct GridSpec {
