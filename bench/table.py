@@ -83,6 +83,22 @@ class Results:
         return rec["cv"].get(counter)
 
 
+def core_share(runs):
+    """Median cpu_time / real_time of the 1-thread, real-time benchmarks: the
+    share of a core they got (1.0 on an idle machine)."""
+    shares = []
+    for rec in runs.values():
+        b = rec.get("values")
+        if not b or rec["info"].get("threads") != "1" or "manual_time" in b.get("name", ""):
+            continue
+        if b.get("real_time", 0) > 0:
+            shares.append(b["cpu_time"] / b["real_time"])
+    if not shares:
+        return None, 0
+    shares.sort()
+    return shares[len(shares) // 2], len(shares)
+
+
 def fmt(x, digits=1):
     if x is None:
         return "–"
@@ -387,6 +403,10 @@ def main():
              "- Times are wall-clock (UseRealTime, or a manual timer where state is restored "
              "between iterations). The machine has 2 cores: 2-thread numbers are only meaningful "
              "when nothing else runs (see the load average)."]
+    share, count = core_share(runs)
+    if share is not None:
+        lines.append(f"- CPU share: the {count} single-thread wall-clock benchmarks got a median "
+                     f"{100 * share:.0f} % of a core (cpu_time / real_time; ~100 % on an idle machine)")
     if args.note:
         lines += [f"- Note: {args.note}"]
     lines.append("")

@@ -89,5 +89,60 @@ TEST(ContactExplore, ThresholdHypothesis) {
     (void)Pprev;
   }
 }
+struct Stats { double m = 0, x = 0, y = 0, vx = 0, vy = 0, Lz = 0, I = 0; };
+Stats body_stats(const Simulation& sim, int material) {
+  const auto v = field(sim, "velocity"), m = field(sim, "mass"), mat = field(sim, "material"), x = field(sim, "position");
+  Stats s;
+  for (std::size_t p = 0; p < sim.particle_count(); ++p) {
+    if (int(mat.at(p)) != material) continue;
+    s.m += m.at(p); s.x += m.at(p) * x.at(p, 0); s.y += m.at(p) * x.at(p, 1);
+    s.vx += m.at(p) * v.at(p, 0); s.vy += m.at(p) * v.at(p, 1);
+  }
+  s.x /= s.m; s.y /= s.m; s.vx /= s.m; s.vy /= s.m;
+  for (std::size_t p = 0; p < sim.particle_count(); ++p) {
+    if (int(mat.at(p)) != material) continue;
+    const double rx = x.at(p, 0) - s.x, ry = x.at(p, 1) - s.y;
+    s.Lz += m.at(p) * (rx * (v.at(p, 1) - s.vy) - ry * (v.at(p, 0) - s.vx));
+    s.I += m.at(p) * (rx * rx + ry * ry);
+  }
+  return s;
+}
+double slope(const std::vector<double>& t, const std::vector<double>& y) {
+  double st = 0, sy = 0, stt = 0, sty = 0; const double n = double(t.size());
+  for (std::size_t k = 0; k < t.size(); ++k) { st += t[k]; sy += y[k]; stt += t[k] * t[k]; sty += t[k] * y[k]; }
+  return (n * sty - st * sy) / (n * stt - st * st);
+}
+TEST(ContactExplore, Incline) {
+  const char* scene = std::getenv("SCENE") ? std::getenv("SCENE") : MMPM_SOURCE_DIR "/inputs/incline_block.toml";
+  std::vector<std::string> ov;
+  if (const char* e = std::getenv("OVS")) {
+    std::string all = e; std::size_t pos = 0;
+    while (pos <= all.size()) { auto q = all.find(';', pos); if (q == std::string::npos) q = all.size(); if (q > pos) ov.push_back(all.substr(pos, q - pos)); pos = q + 1; }
+  }
+  const Scene sc = parse_scene_file(scene, ov);
+  auto sim = make_simulation(sc);
+  const double G = std::hypot(sc.loads[0].acceleration[0], sc.loads[0].acceleration[1]);
+  const double th = std::atan2(sc.loads[0].acceleration[0], -sc.loads[0].acceleration[1]);
+  const double mu = sc.interactions[0].friction;
+  int mat = 0; for (std::size_t m = 0; m < sc.materials.size(); ++m) if (sc.materials[m].type != MaterialType::rigid) mat = int(m);
+  const double tend = std::getenv("TEND") ? atof(std::getenv("TEND")) : sc.simulation.end_time;
+  const double t0 = std::getenv("T0") ? atof(std::getenv("T0")) : 0.3 * tend;
+  std::vector<double> ts, vs, xs, ws, rx, ry;
+  const Stats s0 = body_stats(*sim, mat);
+  int k = 0;
+  while (sim->time() < tend) {
+    sim->step(); ++k;
+    const Stats s = body_stats(*sim, mat);
+    Vec3 r{0, 0, 0};
+    for (const auto& q : sim->reactions()) if (q.name.rfind("rigid:", 0) == 0) r = q.force;
+    if (sim->time() >= t0) { ts.push_back(sim->time()); vs.push_back(s.vx); xs.push_back(s.x - s0.x); ws.push_back(s.Lz / s.I); rx.push_back(r[0]); ry.push_back(r[1]); }
+    if (k % 50 == 0) printf("t %.4f x %.5f y %.5f vx %.5f vy %.5f omega %.4f R %.4g %.4g mm %ld\n", sim->time(), s.x - s0.x, s.y - s0.y, s.vx, s.vy, s.Lz / s.I, r[0], r[1], sim->counters().multimaterial_nodes);
+  }
+  const double a = slope(ts, vs);
+  double mrx = 0, mry = 0; for (std::size_t i = 0; i < rx.size(); ++i) { mrx += rx[i]; mry += ry[i]; } mrx /= rx.size(); mry /= ry.size();
+  const double slide = G * (std::sin(th) - mu * std::cos(th)), roll = 2.0 / 3.0 * G * std::sin(th);
+  printf("G %.3f theta %.2f mu %.3f mass %.5g: a_fit %.4f slide %.4f (%.4f) roll %.4f (%.4f); mean R %.5g %.5g vs weight n %.5g t_slide %.5g t_stick %.5g; omega/v*? %.4f\n",
+         G, th * 180 / M_PI, mu, s0.m, a, slide, a / slide, roll, a / roll, mrx, mry, -s0.m * G * std::cos(th), s0.m * mu * G * std::cos(th), s0.m * G * std::sin(th), slope(ts, ws) / a);
+}
 }  // namespace
 }  // namespace mmpm
