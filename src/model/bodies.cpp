@@ -9,8 +9,9 @@
 namespace mmpm {
 namespace {
 
-// Centre of rotation: the centre of the unrotated bounding box.
+// Centre of rotation: `pivot` if given, else the centre of the unrotated bounding box.
 Vec3 box_center(const BodySpec& b) {
+  if (b.pivot) return *b.pivot;
   if (b.shape == BodyShape::polygon && !b.points.empty()) {
     Vec3 lo = b.points.front(), hi = b.points.front();
     for (const auto& p : b.points)
@@ -51,10 +52,10 @@ std::pair<Vec3, Vec3> bounds(const BodySpec& b, int dim) {
     case BodyShape::box: {
       lo = b.min, hi = b.max;
       if (b.rotate != 0.0) {
-        Vec3 c = box_center(b);
-        double r = 0;
-        for (int d = 0; d < 2; ++d) r += 0.25 * (b.max[d] - b.min[d]) * (b.max[d] - b.min[d]);
-        r = std::sqrt(r);
+        const Vec3 c = box_center(b);
+        double r = 0;  // farthest corner from the centre of rotation
+        for (double x : {b.min[0], b.max[0]})
+          for (double y : {b.min[1], b.max[1]}) r = std::max(r, std::hypot(x - c[0], y - c[1]));
         for (int d = 0; d < 2; ++d) lo[d] = c[d] - r, hi[d] = c[d] + r;
       }
       break;

@@ -205,6 +205,7 @@ void write_body(Writer& w, const BodySpec& b, int dim) {
     }
   }
   if (dim == 2) w.num("rotate", b.rotate);
+  if (dim == 2 && b.pivot) w.vec("pivot", *b.pivot);
   w.integer("particles_per_cell", b.particles_per_cell);
   w.vec("velocity", b.velocity);
   if (b.clip) {

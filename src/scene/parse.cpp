@@ -378,8 +378,8 @@ std::optional<Bounds> body_bounds(const BodySpec& b, int dim) {
   const bool round = b.shape == BodyShape::disk;
   if (dim == 2 && b.rotate != 0.0 && !round) {
     const double a = b.rotate * std::acos(-1.0) / 180.0;
-    const double cx = 0.5 * (box.lo[0] + box.hi[0]);
-    const double cy = 0.5 * (box.lo[1] + box.hi[1]);
+    const double cx = b.pivot ? (*b.pivot)[0] : 0.5 * (box.lo[0] + box.hi[0]);
+    const double cy = b.pivot ? (*b.pivot)[1] : 0.5 * (box.lo[1] + box.hi[1]);
     for (Vec3& p : pts) {
       const double dx = p[0] - cx, dy = p[1] - cy;
       p[0] = cx + std::cos(a) * dx - std::sin(a) * dy;
@@ -734,7 +734,7 @@ class SceneReader {
 
   // -------------------------------------------------------------- [[body]]
   static Keys body_keys(BodyShape shape) {
-    Keys keys{"name", "material", "shape", "rotate", "particles_per_cell", "velocity", "clip"};
+    Keys keys{"name", "material", "shape", "rotate", "pivot", "particles_per_cell", "velocity", "clip"};
     switch (shape) {
       case BodyShape::box:
         keys.insert(keys.end(), {"min", "max"});
@@ -774,6 +774,10 @@ class SceneReader {
     if (auto f = t.get("rotate")) {
       if (dim() == 3) f->fail("only for dimension = 2 (rotation about z of a 2D body)");
       b.rotate = f->number();
+    }
+    if (auto f = t.get("pivot")) {
+      if (dim() == 3) f->fail("only for dimension = 2 (the centre of `rotate`)");
+      b.pivot = f->vec(2);
     }
     if (auto f = t.get("particles_per_cell")) b.particles_per_cell = f->int_at_least(1);
     if (auto f = t.get("velocity")) {

@@ -84,6 +84,7 @@ struct BodySpec {
   BodyShape shape = BodyShape::box;
   Vec3 min{0, 0, 0}, max{0, 0, 0};   // box
   double rotate = 0.0;              // degrees about the body's centre (2D)
+  std::optional<Vec3> pivot;        // rotate about this point instead (a whole specimen of several bodies)
   Vec3 center{0, 0, 0};             // disk, sphere, cylinder
   double radius = 0.0;
   double length = 0.0;              // cylinder (3D): along axis z from center
