@@ -270,7 +270,7 @@ struct Binning {
     const std::size_t n = S.P.n;
     const std::uint32_t nt = tiles.tile_count;
     tile_begin.assign(std::size_t(nt) + 1, 0);
-    for (std::size_t p = 0; p < n; ++p) ++tile_begin[S.P.key[p] / tiles.keys_per_tile + 1];
+    for (std::size_t p = 0; p < n; ++p) ++tile_begin[tiles.tile_of_key(S.P.key[p]) + 1];
     for (std::uint32_t t = 0; t < nt; ++t) tile_begin[t + 1] += tile_begin[t];
     for (auto& c : color_tiles) c.clear();
     for (std::uint32_t t = 0; t < nt; ++t)

@@ -29,10 +29,8 @@ struct TileKeyFn {
   const Binning<D, Real>* bins;
   const ParticleView<D, Real>* P;
   const GridView<D, Real>* G;
-  std::uint32_t tile(std::size_t p) const {
-    return bins->key_of(*P, *G, p) / bins->tiles.keys_per_tile;
-  }
-  std::uint32_t tile_of_key(std::uint32_t k) const { return k / bins->tiles.keys_per_tile; }
+  std::uint32_t tile(std::size_t p) const { return bins->tiles.tile_of_key(bins->key_of(*P, *G, p)); }
+  std::uint32_t tile_of_key(std::uint32_t k) const { return bins->tiles.tile_of_key(k); }
 };
 
 template <int D, class Shape, class Real>

@@ -1,0 +1,554 @@
+// Imperfect interfaces (Nairn 2013; ALGORITHM §3.2, §4) against exact solutions
+// (docs/validation.md §1, §2, §4, §5; tests/analytic.hpp) and against the paper's
+// own checks (location independence, stability at the extremes). Results and the
+// reasons behind every tolerance: docs/interface_validation.md.
+//
+// The runs use the shipped scenes (inputs/series_bars.toml, shear_blocks.toml,
+// dls.toml, sphere_in_cube.toml, two_layer.toml) with --set-style overrides, so the
+// scenes a user runs are the ones validated here. Suite ValidationInterface runs in
+// CI (each test a few seconds on 2 cores); ValidationInterfaceLong holds the
+// refinement studies (ctest -L long).
+//
+// A measured quantity worth knowing before reading the tolerances (interface
+// validation doc, "stiff-interface bias"): the separation δ = x_b − x_a is the
+// difference of the mass-weighted mean displacements of the two materials at a
+// node. With uGIMP and 2 particles per cell those means sit 3h/8 on either side of
+// the interface, so at equilibrium the nodes see δ = [u] + (3h/8)(ε_a + ε_b) and
+// the interface behaves as if its compliance were 1/D − (3h/8)(1/E_a + 1/E_b)
+// (normal) or 1/D − (3h/8)(1/G_a + 1/G_b) (tangential). The tests check that
+// model explicitly: it is first order in h and vanishes for a perfect interface.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "tests/analytic.hpp"
+#include "tests/validation_util.hpp"
+
+namespace mmpm {
+namespace {
+
+using testing::Column;
+using testing::field;
+using testing::run_until;
+
+std::string input_path(const std::string& name) {
+  return std::string(MMPM_SOURCE_DIR) + "/inputs/" + name;
+}
+
+std::unique_ptr<Simulation> make_scene(const std::string& name, const std::vector<std::string>& ov) {
+  return make_simulation(parse_scene_file(input_path(name), ov));
+}
+
+std::string num(double v) {
+  std::ostringstream os;
+  os.precision(17);
+  os << v;
+  std::string s = os.str();
+  if (s.find_first_of(".eE") == std::string::npos && s != "inf") s += ".0";
+  return s;
+}
+
+std::string stiffness_value(double D) { return std::isinf(D) ? "\"perfect\"" : num(D); }
+
+// Least-squares line u = a y + b through the points (y, u).
+struct Line {
+  double slope = 0, intercept = 0;
+  double at(double y) const { return slope * y + intercept; }
+};
+Line fit_line(const std::vector<double>& y, const std::vector<double>& u) {
+  double sy = 0, su = 0, syy = 0, syu = 0;
+  const double n = double(y.size());
+  for (std::size_t k = 0; k < y.size(); ++k) {
+    sy += y[k], su += u[k], syy += y[k] * y[k], syu += y[k] * u[k];
+  }
+  Line l;
+  l.slope = (n * syu - sy * su) / (n * syy - sy * sy);
+  l.intercept = (su - l.slope * sy) / n;
+  return l;
+}
+
+// Static particle state of a finished run.
+struct State {
+  Column pos, disp, mat;
+  Energies e;
+  double x0(std::size_t p, int d) const { return pos.at(p, d) - disp.at(p, d); }
+};
+State state_of(const Simulation& sim) {
+  return {field(sim, "position"), field(sim, "displacement"), field(sim, "material"), sim.energies()};
+}
+
+// Line through displacement component `comp` against the initial coordinate y0 of
+// the particles of material `m` with lo < y0 < hi (one cell away from interfaces and
+// loaded faces, where the discretisation of the load and of the interface bends the
+// field; see the interface validation doc).
+Line fit_material(const State& s, int m, int comp, double lo, double hi) {
+  std::vector<double> y, u;
+  for (std::size_t p = 0; p < s.mat.values.size(); ++p) {
+    if (int(s.mat.at(p)) != m) continue;
+    const double y0 = s.x0(p, 1);
+    if (y0 <= lo || y0 >= hi) continue;
+    y.push_back(y0);
+    u.push_back(s.disp.at(p, comp));
+  }
+  EXPECT_GT(y.size(), 8u);
+  return fit_line(y, u);
+}
+
+bool finite(const Energies& e) {
+  return std::isfinite(e.kinetic) && std::isfinite(e.strain) && std::isfinite(e.interface);
+}
+
+// ---------------------------------------------------------------------------
+// (a) Two bars in series, normal interface (docs/validation.md §1)
+// ---------------------------------------------------------------------------
+// inputs/series_bars.toml: bars A (y 0-5) and B (y 5-10), 2 mm wide (symmetry plane
+// at x = 0, free side at x = 2), 1 mm thick, plane stress, both E = 2400, nu = 0.33:
+// uniaxial stress with E on both sides (same Poisson contraction, so the interface
+// carries no shear and Dt does not matter). Roller base, traction sigma on B's top.
+struct BarsResult {
+  double compliance = 0;  // (u_top - u_bottom) / P from the bulk fields [mm/N]
+  double jump = 0;        // opening at y = 5 from the two bulk fields [mm]
+  Energies e;
+  double slope_a = 0, slope_b = 0;  // strains of the bulk fields
+};
+
+BarsResult run_bars(double Dn, double sigma, double h, double t_end, const std::string& Dt = "\"perfect\"",
+                    const std::vector<std::string>& extra = {}) {
+  const int nx = int(std::lround(4.0 / h)), ny = int(std::lround(12.0 / h));
+  std::vector<std::string> ov = {
+      "grid.cell=[" + num(h) + "," + num(h) + "]",
+      "grid.cells=[" + std::to_string(nx) + "," + std::to_string(ny) + "]",
+      "interaction[0].Dn=" + stiffness_value(Dn),
+      "interaction[0].Dt=" + Dt,
+      "load[0].traction=[0.0," + num(sigma) + "]",
+  };
+  ov.insert(ov.end(), extra.begin(), extra.end());
+  auto sim = make_scene("series_bars.toml", ov);
+  run_until(*sim, t_end);
+  const State s = state_of(*sim);
+  const Line a = fit_material(s, 0, 1, h, 5.0 - h), b = fit_material(s, 1, 1, 5.0 + h, 10.0 - h);
+  BarsResult r;
+  r.compliance = (b.at(10.0) - a.at(0.0)) / (sigma * 2.0);
+  r.jump = b.at(5.0) - a.at(5.0);
+  r.e = s.e;
+  r.slope_a = a.slope;
+  r.slope_b = b.slope;
+  return r;
+}
+
+// Resolution h = 0.5 mm (4 x 20 cells per bar), 2x2 particles per cell, uGIMP, MUSL.
+// Static by damping (1 ms; kinetic/U < 1e-5 checked). The load keeps the opening
+// sigma/Dn <= 1e-3 mm (0.2 % of a cell): the contact area of (P-20) follows the
+// particles, so larger openings soften the interface by about opening/cell.
+// Tolerances: compliance 1.5 %; opening vs the discrete model
+// sigma/Dn - (3h/8)(2 sigma/E) within 1 % of sigma/Dn; interface energy vs
+// P^2/(2 Dn A) within 0.5 %.
+TEST(ValidationInterface, SeriesBarsNormalCompliance) {
+  const double E = 2400, A = 2.0, h = 0.5;
+  for (double Dn : {analytic::kInf, 100.0, 10.0, 1.0}) {
+    const double sigma = std::isinf(Dn) ? 0.01 : std::min(0.01, 1e-3 * Dn);
+    const BarsResult r = run_bars(Dn, sigma, h, 1.0);
+    const auto ex = analytic::series_bars(E, 5.0, E, 5.0, Dn, A, sigma * A);
+    SCOPED_TRACE("Dn = " + num(Dn));
+    EXPECT_TRUE(finite(r.e));
+    EXPECT_LT(r.e.kinetic, 1e-5 * (r.e.strain + r.e.interface)) << "not static";
+    EXPECT_NEAR(r.compliance / ex.compliance, 1.0, 0.015)
+        << "C = " << r.compliance << " exact " << ex.compliance;
+    const double model_jump = ex.jump - 0.375 * h * 2.0 * sigma / E;
+    if (!std::isinf(Dn)) {
+      EXPECT_NEAR((r.jump - model_jump) / ex.jump, 0.0, 0.01)
+          << "opening " << r.jump << ", continuum " << ex.jump << ", discrete model " << model_jump;
+      EXPECT_NEAR(r.e.interface / ex.U_interface, 1.0, 0.005)
+          << "U_int " << r.e.interface << " exact " << ex.U_interface;
+    } else {
+      EXPECT_EQ(r.e.interface, 0.0);
+      EXPECT_NEAR(r.jump / (sigma * 10.0 / E), 0.0, 0.002) << "a perfect interface opened";
+    }
+  }
+}
+
+// Dt does not enter (same Poisson contraction on both sides): Dt = Dn gives the same
+// compliance as Dt = perfect within 0.1 %. h = 0.5 mm, Dn = 10 MPa/mm.
+TEST(ValidationInterface, SeriesBarsTangentialStiffnessDoesNotMatter) {
+  const BarsResult perfect_t = run_bars(10.0, 0.01, 0.5, 1.0, "\"perfect\"");
+  const BarsResult equal_t = run_bars(10.0, 0.01, 0.5, 1.0, "10.0");
+  EXPECT_NEAR(equal_t.compliance / perfect_t.compliance, 1.0, 0.001);
+  EXPECT_NEAR(equal_t.e.interface / perfect_t.e.interface, 1.0, 0.001);
+}
+
+// The stiff-interface bias is first order in h: at 1/Dn = 1e-3 mm/MPa the compliance
+// error (h = 0.5: -3.1 %) halves with every halving of the cell (ratio 0.40-0.60), and
+// the opening follows the discrete model within 2 % of sigma/Dn at every h.
+TEST(ValidationInterfaceLong, SeriesBarsStiffInterfaceBiasConvergesFirstOrder) {
+  MMPM_LONG_TEST();
+  const double E = 2400, A = 2.0, Dn = 1000.0, sigma = 0.01;
+  const auto ex = analytic::series_bars(E, 5.0, E, 5.0, Dn, A, sigma * A);
+  std::vector<double> err;
+  for (double h : {0.5, 0.25, 0.125}) {
+    const BarsResult r = run_bars(Dn, sigma, h, 0.8);
+    err.push_back(r.compliance / ex.compliance - 1.0);
+    const double model_jump = ex.jump - 0.375 * h * 2.0 * sigma / E;
+    EXPECT_NEAR((r.jump - model_jump) / ex.jump, 0.0, 0.02) << "h = " << h;
+    std::printf("[bars 1/Dn=1e-3] h = %.3f  compliance error %+.3f %%  opening %.4g (model %.4g)\n",
+                h, 100 * err.back(), r.jump, model_jump);
+  }
+  for (std::size_t k = 1; k < err.size(); ++k) {
+    EXPECT_LT(err[k], 0.0);
+    EXPECT_NEAR(err[k] / err[k - 1], 0.5, 0.1);
+  }
+}
+
+// ---------------------------------------------------------------------------
+// (b) Two blocks in simple shear, tangential interface (docs/validation.md §2)
+// ---------------------------------------------------------------------------
+// inputs/shear_blocks.toml: block 1 (y 0-2, G1 = 902.26) on a fixed base, block 2
+// (y 2-4, G2 = 500), 4 mm wide, side node columns held in y (they carry the
+// complementary shear), shear traction tau on the top. Dn perfect.
+struct ShearResult {
+  double top = 0, jump = 0;
+  Energies e;
+};
+
+ShearResult run_shear(double Dt, double tau, double t_end) {
+  auto sim = make_scene("shear_blocks.toml", {"interaction[0].Dt=" + stiffness_value(Dt),
+                                              "load[0].traction=[" + num(tau) + ",0.0]"});
+  run_until(*sim, t_end);
+  const State s = state_of(*sim);
+  const double h = 0.5;
+  const Line a = fit_material(s, 0, 0, h, 2.0 - h), b = fit_material(s, 1, 0, 2.0 + h, 4.0 - h);
+  return {b.at(4.0), b.at(2.0) - a.at(2.0), s.e};
+}
+
+// Resolution h = 0.5 mm (8 x 4 cells per block), 2x2 ppc. tau keeps the slip
+// <= 1e-3 mm. Tolerances: top displacement within 1 % of (V 2.2) for 1/Dt >= 0.1 and
+// the perfect interface; at 1/Dt = 0.01, where the stiff-interface bias is -3.6 %,
+// within 0.5 % of (V 2.2) with 1/Dt replaced by 1/Dt - (3h/8)(1/G1 + 1/G2); slip vs
+// that model within 1 % of tau/Dt; interface energy within 0.5 % of tau^2 W t/(2 Dt).
+TEST(ValidationInterface, ShearStackTangentialCompliance) {
+  const double G1 = analytic::shear_modulus(2400, 0.33), G2 = analytic::shear_modulus(1200, 0.2);
+  const double h = 0.5, W = 4.0, bias = 0.375 * h * (1 / G1 + 1 / G2);
+  for (double Dt : {analytic::kInf, 100.0, 10.0, 1.0}) {
+    const double tau = std::isinf(Dt) ? 1e-3 : std::min(1e-3, 1e-3 * Dt);
+    const ShearResult r = run_shear(Dt, tau, 0.8);
+    const auto ex = analytic::shear_stack(G1, 2.0, G2, 2.0, Dt, tau);
+    SCOPED_TRACE("Dt = " + num(Dt));
+    EXPECT_TRUE(finite(r.e));
+    EXPECT_LT(r.e.kinetic, 1e-5 * (r.e.strain + r.e.interface)) << "not static";
+    const double model_top = ex.top_displacement - (std::isinf(Dt) ? 0.0 : tau * bias);
+    if (std::isinf(Dt) || 1 / Dt >= 0.1) {
+      EXPECT_NEAR(r.top / ex.top_displacement, 1.0, 0.01)
+          << "u_top " << r.top << " exact " << ex.top_displacement;
+    } else {
+      EXPECT_NEAR(r.top / model_top, 1.0, 0.005)
+          << "u_top " << r.top << " exact " << ex.top_displacement << " with the bias " << model_top;
+    }
+    if (!std::isinf(Dt)) {
+      EXPECT_NEAR((r.jump - (ex.jump - tau * bias)) / ex.jump, 0.0, 0.01) << "slip " << r.jump;
+      EXPECT_NEAR(r.e.interface / (ex.U_interface_per_area * W), 1.0, 0.005);
+    } else {
+      EXPECT_EQ(r.e.interface, 0.0);
+      EXPECT_NEAR(r.jump / ex.top_displacement, 0.0, 0.002);
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------
+// (c) Double lap shear stiffness vs generalized shear lag (docs/validation.md §4)
+// ---------------------------------------------------------------------------
+struct DlsRun {
+  double k = 0, interface_fraction = 0;
+  Energies e;
+};
+
+DlsRun run_dls(double Dt, double h, double t_end, const std::vector<std::string>& extra = {}) {
+  const int nx = int(std::lround(5.0 / h)), ny = int(std::lround(37.0 / h));
+  std::vector<std::string> ov = {"interaction[0].Dt=" + stiffness_value(Dt),
+                                 "grid.cell=[" + num(h) + "," + num(h) + "]",
+                                 "grid.cells=[" + std::to_string(nx) + "," + std::to_string(ny) + "]"};
+  ov.insert(ov.end(), extra.begin(), extra.end());
+  auto sim = make_scene("dls.toml", ov);
+  run_until(*sim, t_end);
+  DlsRun r;
+  r.e = sim->energies();
+  const double U = r.e.strain + r.e.interface;
+  r.k = analytic::stiffness_from_energy(2.0, U);
+  r.interface_fraction = r.e.interface / U;
+  return r;
+}
+
+// Paper geometry (three 1 mm wood layers, bond 25 mm, P = 2 N on 1 mm depth), grain
+// along y, SN normal, Dn perfect, interfaces on grid lines. h = 0.5 mm (2 cells per
+// layer thickness), 2x2 ppc, MUSL, 0.25 ms. Measured k: +0.8 % (1/Dt = 0.1),
+// +0.3 % (1/Dt = 1). Tolerances: k within 2 % of analytic::dls_stiffness, interface
+// share of the energy within 0.01 of the theory's (0.505, 0.909).
+TEST(ValidationInterface, DlsStiffnessVsShearLag) {
+  for (double inv : {0.1, 1.0}) {
+    const DlsRun r = run_dls(1.0 / inv, 0.5, 0.25);
+    const auto ex = analytic::DlsShearLag({}, {}, 1.0 / inv).result();
+    SCOPED_TRACE("1/Dt = " + num(inv));
+    EXPECT_TRUE(finite(r.e));
+    EXPECT_NEAR(r.k / ex.k, 1.0, 0.02) << "k = " << r.k << " shear lag " << ex.k;
+    EXPECT_NEAR(r.interface_fraction, ex.interface_fraction, 0.01);
+  }
+}
+
+// Refinement h = 0.5 -> 0.25 mm over 1/Dt = 0 (perfect), 0.01, 0.1, 1 (0.25 ms).
+// At h = 0.25 every value is within 1.5 % of the shear-lag k (the perfect end, where
+// the theory's singular end tractions and the bending it ignores matter most, within
+// 2 %), and the error at the perfect end shrinks with refinement.
+TEST(ValidationInterfaceLong, DlsStiffnessRefinement) {
+  MMPM_LONG_TEST();
+  std::vector<double> err_coarse, err_fine;
+  const std::vector<double> inverse = {0.0, 0.01, 0.1, 1.0};
+  for (double inv : inverse) {
+    const double Dt = inv == 0 ? analytic::kInf : 1.0 / inv;
+    const double exact = analytic::dls_stiffness(Dt);
+    const DlsRun c = run_dls(Dt, 0.5, 0.25), f = run_dls(Dt, 0.25, 0.25);
+    err_coarse.push_back(c.k / exact - 1), err_fine.push_back(f.k / exact - 1);
+    std::printf("[dls] 1/Dt = %.2f  k(0.5) = %.2f  k(0.25) = %.2f  shear lag %.2f\n", inv, c.k, f.k, exact);
+    EXPECT_NEAR(f.k / exact, 1.0, inv == 0 ? 0.02 : 0.015) << "1/Dt = " << inv;
+  }
+  EXPECT_LT(std::abs(err_fine[0]), std::abs(err_coarse[0]));
+}
+
+// ---------------------------------------------------------------------------
+// (d) Location independence (paper Fig. 8): interface on a grid line vs on cell
+//     midplanes (grid origin shifted by half a cell), SN normal.
+// ---------------------------------------------------------------------------
+double two_layer_interface_energy(double h, double Dt, bool midplane, double t_end) {
+  const double x0 = -1.0 - (midplane ? 0.5 * h : 0.0);
+  const int nx = int(std::lround(10.0 / h)), ny = int(std::lround(22.0 / h));
+  auto sim = make_scene("two_layer.toml",
+                        {"grid.cell=[" + num(h) + "," + num(h) + "]", "grid.origin=[" + num(x0) + ",-1.0]",
+                         "grid.cells=[" + std::to_string(nx) + "," + std::to_string(ny) + "]",
+                         "interaction[0].Dt=" + num(Dt), "interaction[0].Dn=\"perfect\"",
+                         "interaction[0].normal=\"specified\"", "interaction[0].min_volume=0.0",
+                         "boundary[0].where={min=[-2.0,-2.0],max=[10.0,0.0]}"});
+  run_until(*sim, t_end);
+  const Energies e = sim->energies();
+  EXPECT_TRUE(finite(e));
+  return e.interface;
+}
+
+// Two-layer specimen (inputs/two_layer.toml: 4 x 20 mm layers, 4 mm thick, 0.5 MPa,
+// Dn perfect, SN normal, no volume screening), h = 0.5 mm, 1/Dt = 0.5 mm/MPa, static
+// by 0.8 ms. The contact area (P-20) makes the total interface energy independent of
+// where the interface lies within a cell up to a first-order discretisation error.
+// Tolerance 5 % (measured 3.7 % at h = 0.5; 2.0 % at h = 0.25, see the Long test).
+// For scale: the paper's uncorrected midplane area doubles the effective Dt, which
+// moves the energy by 40 % here (0.461 -> 0.644 N/m^2 for Dt 2 -> 4).
+// History: this bound was first set at 3 %; the measured 3.6-3.7 % failed it, and the
+// refinement study (gap halves with h) is what the test now relies on.
+TEST(ValidationInterface, TwoLayerInterfaceLocationIndependence) {
+  const double grid = two_layer_interface_energy(0.5, 2.0, false, 0.8);
+  const double mid = two_layer_interface_energy(0.5, 2.0, true, 0.8);
+  std::printf("[two-layer h=0.5, 1/Dt=0.5] U_int grid line %.6g, midplane %.6g mJ (ratio %.4f)\n", grid, mid,
+              mid / grid);
+  EXPECT_GT(grid, 0.0);
+  EXPECT_NEAR(mid / grid, 1.0, 0.05);
+}
+
+// The grid-line/midplane gap is first order in h: at 1/Dt = 0.5 it shrinks by a factor
+// 0.35-0.65 from h = 0.5 to h = 0.25 mm, and at h = 0.25 it is below 3 % for
+// 1/Dt = 0.1, 0.5 and 1 (static by 0.8 ms).
+TEST(ValidationInterfaceLong, TwoLayerInterfaceLocationIndependenceFine) {
+  MMPM_LONG_TEST();
+  const double coarse = two_layer_interface_energy(0.5, 2.0, true, 0.8) / two_layer_interface_energy(0.5, 2.0, false, 0.8) - 1;
+  double fine_half = 0;
+  for (double inv : {0.1, 0.5, 1.0}) {
+    const double grid = two_layer_interface_energy(0.25, 1 / inv, false, 0.8);
+    const double mid = two_layer_interface_energy(0.25, 1 / inv, true, 0.8);
+    std::printf("[two-layer h=0.25, 1/Dt=%.2f] U_int grid line %.6g, midplane %.6g mJ\n", inv, grid, mid);
+    EXPECT_NEAR(mid / grid, 1.0, 0.03) << "1/Dt = " << inv;
+    if (inv == 0.5) fine_half = mid / grid - 1;
+  }
+  EXPECT_NEAR(fine_half / coarse, 0.5, 0.15) << "gap h=0.5: " << coarse << ", h=0.25: " << fine_half;
+}
+
+// ---------------------------------------------------------------------------
+// (e) Stability at the extremes (ALGORITHM §4.4, §4.5)
+// ---------------------------------------------------------------------------
+// Series bars (h = 0.5 mm), Dn = Dt = D, load 1e-3 MPa, 0.4 ms (static for D >= 1).
+struct ExtremeRun {
+  bool threw = false;
+  std::string message;
+  Energies e;
+  double compliance = 0;
+  long limited = 0;
+};
+
+ExtremeRun run_extreme(double D, bool force_limit, const std::string& integration, double t_end) {
+  ExtremeRun r;
+  const std::string d = stiffness_value(D);
+  auto sim = make_scene("series_bars.toml",
+                        {"interaction[0].Dn=" + d, "interaction[0].Dt=" + d,
+                         std::string("interaction[0].force_limit=") + (force_limit ? "true" : "false"),
+                         "interaction[0].integration=\"" + integration + "\"", "load[0].traction=[0.0,0.001]"});
+  try {
+    while (sim->time() < t_end) {
+      sim->step();
+      r.limited = std::max(r.limited, sim->counters().force_limited_nodes);
+      if (sim->step_count() % 50 == 0 && !finite(sim->energies())) break;
+    }
+  } catch (const SimulationError& e) {
+    r.threw = true;
+    r.message = e.what();
+  }
+  r.e = sim->energies();
+  if (!r.threw && finite(r.e)) {
+    const State s = state_of(*sim);
+    const Line a = fit_material(s, 0, 1, 0.5, 4.5), b = fit_material(s, 1, 1, 5.5, 9.5);
+    r.compliance = (b.at(10.0) - a.at(0.0)) / (0.001 * 2.0);
+  }
+  return r;
+}
+
+// With the force limit, 1/D from 1e-12 to 1e3 mm/MPa and "perfect" all run to the end
+// with finite energies. Bounded: the stored energy never exceeds twice the static
+// energy at that D (a ramped load overshoots by less), and for D >= 1e6 the stiff
+// directions become stick (force-limited counts > 0) and the compliance equals the
+// perfect one within 0.5 %, with no interface energy above 1e-3 of the strain energy.
+TEST(ValidationInterface, ExtremesStableWithForceLimit) {
+  const double E = 2400, A = 2.0, P = 0.001 * A;
+  const double C_perfect = analytic::series_bars(E, 5, E, 5, analytic::kInf, A, P).compliance;
+  for (double D : {analytic::kInf, 1e12, 1e9, 1e6, 1e3, 1.0, 1e-3}) {
+    SCOPED_TRACE("D = " + num(D));
+    const ExtremeRun r = run_extreme(D, true, "explicit", 0.4);
+    ASSERT_FALSE(r.threw) << r.message;
+    ASSERT_TRUE(finite(r.e));
+    const auto ex = analytic::series_bars(E, 5, E, 5, D, A, P);
+    EXPECT_LE(r.e.strain + r.e.interface + r.e.kinetic, 2.0 * ex.U_total);
+    if (D >= 1e6) {
+      if (!std::isinf(D)) {
+        EXPECT_GT(r.limited, 0);
+      }
+      EXPECT_NEAR(r.compliance / C_perfect, 1.0, 0.005);
+      EXPECT_LT(r.e.interface, 1e-3 * r.e.strain);
+    }
+  }
+}
+
+// Without the force limit the stiff end misbehaves: at D >= 1e6 MPa/mm the explicit
+// interface spring (omega dt >> 2 at the interface nodes) is unstable, and the run
+// either stops with "unstable" or its energies leave every physical bound (non-finite,
+// or more than 10x the static energy). The soft end (D = 1) is unaffected.
+TEST(ValidationInterface, ExtremesUnstableWithoutForceLimit) {
+  const double E = 2400, A = 2.0, P = 0.001 * A;
+  for (double D : {1e12, 1e6}) {
+    SCOPED_TRACE("D = " + num(D));
+    const ExtremeRun r = run_extreme(D, false, "explicit", 0.05);
+    const auto ex = analytic::series_bars(E, 5, E, 5, D, A, P);
+    const bool blew_up = r.threw || !finite(r.e) ||
+                         r.e.strain + r.e.interface + r.e.kinetic > 10 * ex.U_total;
+    EXPECT_TRUE(blew_up) << "energy " << r.e.strain + r.e.interface + r.e.kinetic << " static " << ex.U_total;
+  }
+  const ExtremeRun soft = run_extreme(1.0, false, "explicit", 0.05);
+  EXPECT_FALSE(soft.threw) << soft.message;
+  EXPECT_TRUE(finite(soft.e));
+}
+
+// integration = "exact" (ALGORITHM §4.5) is stable at the stiff end without any force
+// limit: D = 1e12 and 1e6 give the perfect compliance within 0.5 %; D = 1e3 gives the
+// explicit scheme's compliance within 0.5 %.
+TEST(ValidationInterface, ExtremesExactIntegrationStable) {
+  const double E = 2400, A = 2.0, P = 0.001 * A;
+  const double C_perfect = analytic::series_bars(E, 5, E, 5, analytic::kInf, A, P).compliance;
+  for (double D : {1e12, 1e6}) {
+    SCOPED_TRACE("D = " + num(D));
+    const ExtremeRun r = run_extreme(D, false, "exact", 0.4);
+    ASSERT_FALSE(r.threw) << r.message;
+    ASSERT_TRUE(finite(r.e));
+    EXPECT_NEAR(r.compliance / C_perfect, 1.0, 0.005);
+  }
+  const ExtremeRun ex = run_extreme(1e3, false, "exact", 0.4), ep = run_extreme(1e3, true, "explicit", 0.4);
+  ASSERT_FALSE(ex.threw || ep.threw);
+  EXPECT_NEAR(ex.compliance / ep.compliance, 1.0, 0.005);
+}
+
+// ---------------------------------------------------------------------------
+// (f) 3D sphere in a cube: bulk modulus vs the composite spheres assemblage
+// ---------------------------------------------------------------------------
+struct CubeRun {
+  double K_energy = 0, K_pressure = 0, interface_fraction = 0;
+  Energies e;
+};
+
+// inputs/sphere_in_cube.toml: 1 mm cube, eps0 = 0.5 %, symmetry planes held, outer
+// faces displaced (boxes 3, 4, 5). K from energy (P-35) and from the mean normal
+// reaction on the three outer faces, each of area 1 mm^2 (P-36).
+CubeRun run_cube(double D, double h, int ppc, double t_end, const std::vector<std::string>& extra = {}) {
+  const int n = int(std::lround(1.3 / h));
+  std::vector<std::string> ov = {"interaction[0].Dn=" + stiffness_value(D), "interaction[0].Dt=" + stiffness_value(D),
+                                 "grid.cell=[" + num(h) + "," + num(h) + "," + num(h) + "]",
+                                 "grid.cells=[" + std::to_string(n) + "," + std::to_string(n) + "," +
+                                     std::to_string(n) + "]",
+                                 "body[0].particles_per_cell=" + std::to_string(ppc),
+                                 "body[1].particles_per_cell=" + std::to_string(ppc)};
+  ov.insert(ov.end(), extra.begin(), extra.end());
+  auto sim = make_scene("sphere_in_cube.toml", ov);
+  run_until(*sim, t_end);
+  CubeRun r;
+  r.e = sim->energies();
+  const double eps0 = 0.005, l = 1.0;
+  const double U = r.e.strain + r.e.interface;
+  r.K_energy = analytic::bulk_from_energy(U, l * l * l, eps0);
+  double mean = 0;
+  for (const Reaction& re : sim->reactions()) {
+    if (re.name == "box3") mean += re.force[0];
+    if (re.name == "box4") mean += re.force[1];
+    if (re.name == "box5") mean += re.force[2];
+  }
+  r.K_pressure = analytic::bulk_from_pressure(mean / 3.0 / (l * l), eps0);
+  r.interface_fraction = r.e.interface / U;
+  return r;
+}
+
+double csa(double D) {
+  const double Ki = analytic::bulk_modulus(70000, 0.25), Km = analytic::bulk_modulus(2400, 0.33),
+               Gm = analytic::shear_modulus(2400, 0.33);
+  return analytic::csa_bulk(Ki, Km, Gm, std::numbers::pi / 6 * 0.343, 0.7, D);
+}
+
+// 100 um cells (10 across the cube), 1 particle per cell per direction (1000
+// particles), radial normal, Dn = Dt = 1e4 MPa/mm (1/D = 1e-4, the middle of the
+// transition: CSA 2328.7 MPa, 17 % of the energy in the interface), 0.012 ms.
+// Generous tolerance: both K within 6 % of CSA (measured +4.4 % energy, +2.6 %
+// pressure; the cube is a cubic array, not the CSA, and h = 100 um gives the
+// stiff-interface bias of about +2 % here), and K_energy >= K_pressure - 1 %.
+TEST(ValidationInterface, SphereInCubeBulkModulusCoarse) {
+  const CubeRun r = run_cube(1e4, 0.1, 1, 0.012);
+  const double exact = csa(1e4);
+  std::printf("[cube h=0.1 ppc=1 1/D=1e-4] K_energy %.1f  K_pressure %.1f  CSA %.1f  U_int/U %.3f\n",
+              r.K_energy, r.K_pressure, exact, r.interface_fraction);
+  EXPECT_TRUE(finite(r.e));
+  EXPECT_NEAR(r.K_energy / exact, 1.0, 0.06);
+  EXPECT_NEAR(r.K_pressure / exact, 1.0, 0.06);
+  EXPECT_GT(r.interface_fraction, 0.1);
+}
+
+// 100 um and 50 um cells, 2 particles per cell per direction, at 1/D = 1e-6 (near
+// perfect), 1e-4 (transition) and 1e-2 (nearly debonded): both K within 5 % of CSA at
+// 50 um, and at 1/D = 1e-4 the 50 um error is smaller than the 100 um error.
+TEST(ValidationInterfaceLong, SphereInCubeBulkModulusRefinement) {
+  MMPM_LONG_TEST();
+  for (double inv : {1e-6, 1e-4, 1e-2}) {
+    const double exact = csa(1 / inv);
+    const CubeRun c = run_cube(1 / inv, 0.1, 2, 0.015), f = run_cube(1 / inv, 0.05, 2, 0.015);
+    std::printf("[cube 1/D=%.0e] 100um: K_e %.1f K_p %.1f | 50um: K_e %.1f K_p %.1f | CSA %.1f\n", inv,
+                c.K_energy, c.K_pressure, f.K_energy, f.K_pressure, exact);
+    EXPECT_NEAR(f.K_energy / exact, 1.0, 0.05) << "1/D = " << inv;
+    EXPECT_NEAR(f.K_pressure / exact, 1.0, 0.05) << "1/D = " << inv;
+    if (inv == 1e-4) {
+      EXPECT_LT(std::abs(f.K_energy / exact - 1), std::abs(c.K_energy / exact - 1));
+    }
+  }
+}
+
+}  // namespace
+}  // namespace mmpm
