@@ -35,6 +35,16 @@ std::vector<std::string> split_values(const std::string& text) {
   return out;
 }
 
+// RFC 4180 field: quoted, inner quotes doubled.
+static std::string csv_quoted(const std::string& s) {
+  std::string out = "\"";
+  for (char c : s) {
+    if (c == '"') out += '"';
+    out += c;
+  }
+  return out + "\"";
+}
+
 int run_sweep(const SweepOptions& opt) {
   namespace fs = std::filesystem;
   const std::size_t n = opt.values.size();
@@ -80,10 +90,7 @@ int run_sweep(const SweepOptions& opt) {
   int code = 0;
   for (std::size_t k = 0; k < n; ++k) {
     const auto& r = results[k];
-    std::string value = opt.values[k];
-    for (char& c : value)
-      if (c == ',') c = ';';
-    csv << k << ",\"" << value << "\"," << (r.exit_code == 0 ? "ok" : "failed") << ",";
+    csv << k << "," << csv_quoted(opt.values[k]) << "," << (r.exit_code == 0 ? "ok" : "failed") << ",";
     if (r.exit_code == 0) {
       const auto& j = r.summary;
       const auto& e = j["energy"];
@@ -92,7 +99,7 @@ int run_sweep(const SweepOptions& opt) {
           << "," << e["damping"] << "," << j["multimaterial_nodes"] << "," << j["force_limited_nodes"]
           << "," << j["stopped_by"].get<std::string>();
     } else {
-      csv << ",,,,,,,,,,,," << "\"" << r.message.substr(0, 200) << "\"";
+      csv << ",,,,,,,,,,,," << csv_quoted(r.message.substr(0, 200));
       code = 3;
     }
     csv << "," << (dir / std::to_string(k)).string() << "\n";
