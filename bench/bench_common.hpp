@@ -33,6 +33,11 @@
 #include "kernels/weights.hpp"
 #include "model/staggered_array.hpp"
 
+namespace mmpm {
+class Simulation;
+enum class Scheme;
+}  // namespace mmpm
+
 namespace mmpm::bench {
 
 // Registration entry points, called in this order by bench_main.cpp.
@@ -41,6 +46,11 @@ void register_g2p();
 void register_multimaterial();
 void register_sort();
 void register_step();
+void register_mm_scene();
+
+// The whole-step two-layer scene (bench_step.cpp), shared with bench_mm_scene.cpp.
+Simulation& two_layer_interface_simulation();
+Scheme two_layer_interface_scheme();
 
 template <class Real>
 inline const char* real_name() {

@@ -144,7 +144,7 @@ void register_g2p_case() {
                              "/real:" + real_name<Real>() + "/threads:" + std::to_string(threads);
     benchmark::RegisterBenchmark(name.c_str(), [threads](benchmark::State& st) {
       bm_g2p<D, Shape, Real>(st, threads);
-    })->UseRealTime()->MinTime(min_time(0.15))->Unit(benchmark::kMillisecond);
+    })->UseRealTime()->MinTime(min_time(0.2))->Unit(benchmark::kMillisecond);
   }
 }
 
@@ -159,7 +159,7 @@ void register_dim_real() {
                              real_name<Real>() + "/threads:" + std::to_string(threads);
     benchmark::RegisterBenchmark(name.c_str(), [threads](benchmark::State& st) {
       bm_constitutive<D, Real>(st, threads);
-    })->UseRealTime()->MinTime(min_time(0.15))->Unit(benchmark::kMillisecond);
+    })->UseRealTime()->MinTime(min_time(0.2))->Unit(benchmark::kMillisecond);
   }
 }
 

@@ -124,7 +124,7 @@ void register_case() {
     name += "/threads:" + std::to_string(threads);
     benchmark::RegisterBenchmark(name.c_str(), [s, tile, threads](benchmark::State& st) {
       bm_p2g<D, Shape, Real>(st, s, tile, threads);
-    })->UseRealTime()->MinTime(min_time(0.15))->Unit(benchmark::kMillisecond);
+    })->UseRealTime()->MinTime(min_time(0.2))->Unit(benchmark::kMillisecond);
   };
   const int T = kDefaultTile<D>;
   add(Strategy::serial, T, 1);
@@ -146,7 +146,7 @@ void register_tiles() {
                                std::to_string(tile) + "/threads:" + std::to_string(threads);
       benchmark::RegisterBenchmark(name.c_str(), [tile, threads](benchmark::State& st) {
         bm_p2g<D, Shape, Real>(st, Strategy::colored, tile, threads);
-      })->UseRealTime()->MinTime(min_time(0.15))->Unit(benchmark::kMillisecond);
+      })->UseRealTime()->MinTime(min_time(0.2))->Unit(benchmark::kMillisecond);
     }
 }
 

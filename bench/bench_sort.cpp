@@ -124,7 +124,7 @@ void register_case() {
                                "/threads:" + std::to_string(threads);
       benchmark::RegisterBenchmark(name.c_str(), [shuffled, threads](benchmark::State& st) {
         bm_sort<D, Real>(st, shuffled, threads);
-      })->UseManualTime()->MinTime(min_time(0.15))->Unit(benchmark::kMillisecond);
+      })->UseManualTime()->MinTime(min_time(0.2))->Unit(benchmark::kMillisecond);
     }
 }
 

@@ -249,6 +249,17 @@ void add(const StepCase& c, int threads, int repetitions = 1) {
 
 }  // namespace
 
+Scheme two_layer_interface_scheme() {
+  static const Scheme scheme =
+      parse_scene_text(two_layer(true, true), "2d_gimp_interface.toml").simulation.scheme;
+  return scheme;
+}
+
+Simulation& two_layer_interface_simulation() {
+  static const StepCase c{"2d_gimp_interface", two_layer(true, true), {}};
+  return simulation_for(c);
+}
+
 void register_step() {
   const StepCase linear{"2d_linear_1mat", kLinear2D, {}};
   const StepCase interface{"2d_gimp_interface", two_layer(true, true), {}};
@@ -262,8 +273,8 @@ void register_step() {
   for (int threads : {1, 2}) add(gimp3d, threads);
   // The unused-feature pair: repeated, so the table can show the noise.
   for (int threads : {1, 2}) {
-    add(one_mat, threads, 3);
-    add(shared, threads, 3);
+    add(one_mat, threads, 5);
+    add(shared, threads, 5);
   }
   for (int every : {1, 10, 100})
     for (int threads : {1, 2})

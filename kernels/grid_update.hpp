@@ -43,7 +43,17 @@ double grid_update(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
         const std::size_t i = o + n;
         const Real m = G.m[i];
         if (!(m > thr)) {
-          for (int d = 0; d < D; ++d) V.dvel[d][i] = Real(0);
+          // A sliver of mass (a particle barely reaching the node): its
+          // velocity is not trusted (vel = 0 for positions and strain
+          // rates), but the force it collects still reaches the particles
+          // as a FLIP increment S dt f / m (finite: S ~ m), or momentum
+          // would be lost at every uGIMP surface.
+          const bool some = m > Real(0) && !rigid;
+          for (int d = 0; d < D; ++d) {
+            Real force = G.f[d][i] + m * gacc[d];
+            if (q.has_interface_force) force += G.fi[d][i];
+            V.dvel[d][i] = some ? dt * force / m : Real(0);
+          }
           continue;
         }
         const Real inv_m = Real(1) / m;
@@ -68,7 +78,8 @@ double grid_update(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
   return loss;
 }
 
-// vel = p/m, dvel += vel (completing v_new - v_old), after pass B.
+// vel = p/m, dvel += vel (completing v_new - v_old), after pass B; nodes
+// with a sliver of mass keep vel = 0 and the increment grid_update gave them.
 template <int D, class Real>
 void grid_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V, Real thr) {
   const std::size_t total = G.nodes * std::size_t(G.fields);
@@ -83,7 +94,7 @@ void grid_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
         V.dvel[d][i] += v;
       }
     } else {
-      for (int d = 0; d < D; ++d) V.vel[d][i] = V.dvel[d][i] = Real(0);
+      for (int d = 0; d < D; ++d) V.vel[d][i] = Real(0);  // dvel: set by grid_update
     }
   }
 }

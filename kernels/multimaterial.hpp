@@ -379,6 +379,16 @@ inline void add_reaction(ChunkStats& cs, int rigid_field, const VecD<D, Real>& m
         double(momentum_change[d]) * double(inv_dt) + double(force[d]);
 }
 
+// The momentum change that counts toward a rigid body's reaction. Particles
+// take their FLIP velocity increment from the momenta after pass A, so pass
+// A's contact changes never reach them; the reaction the deformable body
+// feels is pass B's change (plus the interface forces, counted in pass A).
+template <int D, class Real, bool kPassA>
+inline VecD<D, Real> reaction_change(const InteractionResult<D, Real>& r) {
+  if constexpr (kPassA) return VecD<D, Real>{};
+  return r.momentum_change;
+}
+
 // One node of the list, pass A (kPassA) or pass B.
 template <int D, class Real, bool kPassA>
 void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::size_t k,
@@ -430,8 +440,7 @@ void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::si
     const bool b_rigid = rigid0 || rigid1;
     const InteractionResult<D, Real> r = interact(nf.side[ia], nf.side[ib], b_rigid, *pp, fa);
     apply(fa, r.momentum_change, r.force, Real(1));
-    if (b_rigid)
-      add_reaction<D, Real>(cs, fb, r.momentum_change, r.force, inv_dt);
+    if (b_rigid) add_reaction<D, Real>(cs, fb, reaction_change<D, Real, kPassA>(r), r.force, inv_dt);
     else
       apply(fb, r.momentum_change, r.force, Real(-1));
     if constexpr (kPassA) {
@@ -470,7 +479,8 @@ void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::si
         interact(nf.side[ia], b_rigid ? nf.side[partner] : lump, b_rigid, pp, fa);
     change[ia] = r.momentum_change;
     force[ia] = r.force;
-    if (b_rigid) add_reaction<D, Real>(cs, nf.field[partner], r.momentum_change, r.force, inv_dt);
+    if (b_rigid)
+      add_reaction<D, Real>(cs, nf.field[partner], reaction_change<D, Real, kPassA>(r), r.force, inv_dt);
     if constexpr (kPassA) {
       // Energy once per node among lumped interactions, once per rigid interaction (§6).
       if (b_rigid) {

@@ -901,9 +901,19 @@ TEST(MultimaterialRigid, ContactChangesOnlyDeformableAndRecordsReaction) {
   EXPECT_NEAR(grid.velocity(1, 0, 1), 0.0, kTol);
   EXPECT_EQ(grid.momentum(0, 0, 0), 5.0 * -0.5);  // rigid p never modified
   EXPECT_EQ(grid.momentum(0, 0, 1), 0.0);
-  EXPECT_NEAR(stats.rigid_reaction[0][0], 3.0 / 0.25, kTol);
-  EXPECT_NEAR(stats.rigid_reaction[0][1], 0.4 / 0.25, kTol);
-  EXPECT_EQ(stats.rigid_reaction[1][0], 0.0);
+  // Pass A's contact change never reaches the particles (their FLIP
+  // increment starts after it), so it is not part of the reaction.
+  EXPECT_EQ(stats.rigid_reaction[0][0], 0.0);
+  EXPECT_EQ(stats.rigid_reaction[0][1], 0.0);
+  // Pass B on the same momenta: this change is the impulse on the rigid body.
+  grid.set(1, 0, 2.0, {1, 0.2, 0}, {0, 0, 0}, 0.5);
+  MMStats stats_b;
+  stats_b.reset(2);
+  run_pass_b(grid, setup, stats_b, flags);
+  EXPECT_NEAR(grid.velocity(1, 0, 0), -0.5, kTol);
+  EXPECT_NEAR(stats_b.rigid_reaction[0][0], 3.0 / 0.25, kTol);
+  EXPECT_NEAR(stats_b.rigid_reaction[0][1], 0.4 / 0.25, kTol);
+  EXPECT_EQ(stats_b.rigid_reaction[1][0], 0.0);
 }
 
 TEST(MultimaterialRigid, InterfaceForceOnlyOnDeformableWithRigidNormal) {
@@ -1026,8 +1036,22 @@ TEST(MultimaterialThreePlus, RigidPartnerTakesPrecedenceAndEnergyPerInteraction)
   run_pass_a(grid, setup, stats, flags);
   for (int j = 0; j < 2; ++j)
     for (int d = 0; d < 2; ++d) EXPECT_NEAR(grid.velocity(j, 0, d), 0.0, kTol);
-  EXPECT_NEAR(stats.rigid_reaction[2][0], (1.0 + 1.0) / 0.5, kTol);  // −Σ Δp / Δt
-  EXPECT_NEAR(stats.rigid_reaction[2][1], 0.5 / 0.5, kTol);
+  EXPECT_EQ(stats.rigid_reaction[2][0], 0.0);  // pass A's changes are not impulses (see above)
+  {
+    TestGrid<2, double> gb({1, 1, 1}, 3);
+    gb.set(0, 0, 1.0, {1, 0.5, 0}, {0, 0, 0}, 0.3);
+    gb.set(1, 0, 2.0, {0.5, 0, 0}, {0.01, 0, 0}, 0.3);
+    gb.set(2, 0, 4.0, {0, 0, 0}, {-0.02, 0, 0}, 0.4);
+    MMStats sa, sb;
+    std::vector<unsigned char> fl;
+    run_pass_a(gb, setup, sa, fl);
+    gb.set(0, 0, 1.0, {1, 0.5, 0}, {0, 0, 0}, 0.3);
+    gb.set(1, 0, 2.0, {0.5, 0, 0}, {0.01, 0, 0}, 0.3);
+    sb.reset(3);
+    run_pass_b(gb, setup, sb, fl);
+    EXPECT_NEAR(sb.rigid_reaction[2][0], (1.0 + 1.0) / 0.5, kTol);  // −Σ Δp / Δt
+    EXPECT_NEAR(sb.rigid_reaction[2][1], 0.5 / 0.5, kTol);
+  }
 
   TestGrid<2, double> g2({1, 1, 1}, 3);
   g2.set(0, 0, 1e6, {0, 0, 0}, {0, 0, 0}, 0.3);

@@ -1,148 +1,441 @@
+// Contact validation: whole-solver runs of the scenes inputs/collision.toml,
+// inputs/incline_block.toml and inputs/incline_disk.toml against exact
+// solutions (docs/contact_validation.md derives every number used here and
+// lists the values measured). Every test states its resolution and tolerance.
+//
+//   head-on impact of two identical blocks (§2): momentum every step, velocity
+//     exchange, kinetic energy, independence of where the contact plane lies;
+//   block on a rigid incline with Coulomb friction (§3): sliding acceleration,
+//     sticking, reaction on the rigid floor, contact plane on a grid line or
+//     at cell mid-height;
+//   disk on a rigid incline (§4): rolling without slipping, sliding.
+//
+// The scenes are loaded from inputs/ (the same physics `mmpm run` runs), with
+// --set style overrides for the variants.
 #include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
 #include <cstdio>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <numbers>
+#include <string>
+#include <vector>
+
 #include "tests/validation_util.hpp"
+
 namespace mmpm {
 namespace {
+
 using testing::field;
 
-struct Body { double m = 0, px = 0, py = 0, x = 0, y = 0, maxx = -1e9, minx = 1e9; };
+std::string input(const std::string& name) { return std::string(MMPM_SOURCE_DIR) + "/inputs/" + name; }
 
-TEST(ContactExplore, Collision) {
-  const char* law = std::getenv("LAW") ? std::getenv("LAW") : "frictionless";
-  const char* nrm = std::getenv("NRM") ? std::getenv("NRM") : "avg";
-  std::vector<std::string> ov = {std::string("interaction[0].law=\"") + law + "\"",
-                                 std::string("interaction[0].normal=\"") + nrm + "\""};
-  if (const char* e = std::getenv("OVS")) {
-    std::string all = e; std::size_t pos = 0;
-    while (pos <= all.size()) { auto q = all.find(';', pos); if (q == std::string::npos) q = all.size(); if (q > pos) ov.push_back(all.substr(pos, q - pos)); pos = q + 1; }
-  }
-  auto sim = make_simulation(parse_scene_file(std::getenv("SCENE") ? std::getenv("SCENE") : MMPM_SOURCE_DIR "/inputs/collision.toml", std::getenv("SCENE") ? std::vector<std::string>{} : ov));
-  double P0 = 0;
-  double maxerr = 0;
-  const double tend = std::getenv("TEND") ? atof(std::getenv("TEND")) : 0.25;
-  int k = 0;
-  while (sim->time() < tend) {
-    const auto v = field(*sim, "velocity"), m = field(*sim, "mass"), mat = field(*sim, "material"), x = field(*sim, "position");
-    Body b[2];
-    double P = 0, Py = 0;
-    for (std::size_t p = 0; p < sim->particle_count(); ++p) {
-      int j = int(mat.at(p));
-      b[j].m += m.at(p); b[j].px += m.at(p) * v.at(p, 0); b[j].py += m.at(p) * v.at(p, 1);
-      b[j].x += m.at(p) * x.at(p, 0);
-      b[j].maxx = std::max(b[j].maxx, x.at(p, 0)); b[j].minx = std::min(b[j].minx, x.at(p, 0));
-      P += m.at(p) * v.at(p, 0); Py += m.at(p) * v.at(p, 1);
-    }
-    if (k == 0) P0 = P;
-    maxerr = std::max(maxerr, std::abs(P - P0) / std::abs(P0));
-    const auto e = sim->energies();
-    if (k % 10 == 0 || std::getenv("ALL"))
-      printf("t %.4f vA %.5f vB %.5f  Perr %.3e Py %.2e KE %.5f SE %.5f TOT %.5f gapAB %.4f mm %ld\n", sim->time(), b[0].px / b[0].m, b[1].px / b[1].m,
-             (P - P0) / P0, Py, e.kinetic, e.strain, e.kinetic + e.strain, b[1].minx - b[0].maxx, sim->counters().multimaterial_nodes);
-    sim->step();
-    ++k;
-  }
-  printf("max perr %.3e\n", maxerr);
-}
-// Predict the momentum lost at nodes whose field mass is below the grid threshold.
-TEST(ContactExplore, ThresholdHypothesis) {
-  std::vector<std::string> ov = {"interaction[0].min_volume=0.5"};
-  auto sim = make_simulation(parse_scene_file(MMPM_SOURCE_DIR "/inputs/collision.toml", ov));
-  const double h = 0.5, l = 0.25, dt = sim->dt();
-  auto gimp = [&](double d, double& w, double& dw) {
-    const double a = std::abs(d), sgn = d < 0 ? -1 : 1;
-    if (a < l) { w = 1 - (d * d + l * l) / (2 * l); dw = -d / l; }
-    else if (a < 1 - l) { w = 1 - a; dw = -sgn; }
-    else if (a < 1 + l) { const double q = 1 + l - a; w = q * q / (4 * l); dw = -sgn * q / (2 * l); }
-    else { w = 0; dw = 0; }
-  };
-  double min_mass = 1e300;
-  { auto m = field(*sim, "mass"); for (double v : m.values) min_mass = std::min(min_mass, v); }
-  const double thr = 1e-9 * min_mass;
-  double Pprev = 0;
-  for (int k = 0; k < 200; ++k) {
-    const auto v = field(*sim, "velocity"), m = field(*sim, "mass"), mat = field(*sim, "material"),
-               x = field(*sim, "position"), s = field(*sim, "stress"), V = field(*sim, "volume");
-    double P = 0;
-    for (std::size_t p = 0; p < sim->particle_count(); ++p) P += m.at(p) * v.at(p, 0);
-    // nodal mass and force per field on a 51 x 17 grid
-    std::vector<double> nm(2 * 51 * 17, 0), fx(2 * 51 * 17, 0);
-    for (std::size_t p = 0; p < sim->particle_count(); ++p) {
-      const int j = int(mat.at(p));
-      const double xi = x.at(p, 0) / h, yi = x.at(p, 1) / h;
-      const int bx = int(std::floor(xi - 0.5)), by = int(std::floor(yi - 0.5));
-      for (int a = 0; a < 3; ++a) for (int b = 0; b < 3; ++b) {
-        double wx, dwx, wy, dwy;
-        gimp(xi - (bx + a), wx, dwx); gimp(yi - (by + b), wy, dwy);
-        const std::size_t n = std::size_t(j) * 51 * 17 + std::size_t(by + b) * 51 + std::size_t(bx + a);
-        nm[n] += wx * wy * m.at(p);
-        const double gx = dwx * wy / h, gy = wx * dwy / h;
-        fx[n] -= V.at(p) * (s.at(p, 0) * gx + s.at(p, 2) * gy);
-      }
-    }
-    double lost = 0; int count = 0;
-    for (std::size_t n = 0; n < nm.size(); ++n) if (!(nm[n] > thr) && fx[n] != 0) { lost += fx[n] * dt; ++count; }
-    sim->step();
-    const auto v2 = field(*sim, "velocity"), m2 = field(*sim, "mass");
-    double P2 = 0;
-    for (std::size_t p = 0; p < sim->particle_count(); ++p) P2 += m2.at(p) * v2.at(p, 0);
-    if (std::abs(P2 - P) > 1e-15 || count) printf("step %d dP %.3e predicted(-lost) %.3e nodes %d\n", k, P2 - P, -lost, count);
-    (void)Pprev;
-  }
-}
-struct Stats { double m = 0, x = 0, y = 0, vx = 0, vy = 0, Lz = 0, I = 0; };
-Stats body_stats(const Simulation& sim, int material) {
-  const auto v = field(sim, "velocity"), m = field(sim, "mass"), mat = field(sim, "material"), x = field(sim, "position");
-  Stats s;
-  for (std::size_t p = 0; p < sim.particle_count(); ++p) {
-    if (int(mat.at(p)) != material) continue;
-    s.m += m.at(p); s.x += m.at(p) * x.at(p, 0); s.y += m.at(p) * x.at(p, 1);
-    s.vx += m.at(p) * v.at(p, 0); s.vy += m.at(p) * v.at(p, 1);
-  }
-  s.x /= s.m; s.y /= s.m; s.vx /= s.m; s.vy /= s.m;
-  for (std::size_t p = 0; p < sim.particle_count(); ++p) {
-    if (int(mat.at(p)) != material) continue;
-    const double rx = x.at(p, 0) - s.x, ry = x.at(p, 1) - s.y;
-    s.Lz += m.at(p) * (rx * (v.at(p, 1) - s.vy) - ry * (v.at(p, 0) - s.vx));
-    s.I += m.at(p) * (rx * rx + ry * ry);
-  }
+std::string num(double x) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.17g", x);
+  std::string s = buf;
+  if (s.find_first_of(".e") == std::string::npos) s += ".0";
   return s;
 }
+
+// Mass, centre of mass, its velocity, and the spin (angular momentum about the
+// centre of mass / polar moment of inertia) of the particles of one material.
+struct BodyState {
+  double m = 0, x = 0, y = 0, vx = 0, vy = 0, omega = 0, I = 0;
+  double min_x = std::numeric_limits<double>::infinity();
+  double max_x = -std::numeric_limits<double>::infinity();
+};
+
+std::vector<BodyState> body_states(const Simulation& sim, std::size_t materials) {
+  const auto v = field(sim, "velocity"), m = field(sim, "mass"), mat = field(sim, "material"),
+             x = field(sim, "position");
+  std::vector<BodyState> b(materials);
+  const std::size_t n = sim.particle_count();
+  for (std::size_t p = 0; p < n; ++p) {
+    BodyState& s = b[std::size_t(mat.at(p))];
+    const double mp = m.at(p);
+    s.m += mp;
+    s.x += mp * x.at(p, 0), s.y += mp * x.at(p, 1);
+    s.vx += mp * v.at(p, 0), s.vy += mp * v.at(p, 1);
+    s.min_x = std::min(s.min_x, x.at(p, 0)), s.max_x = std::max(s.max_x, x.at(p, 0));
+  }
+  for (auto& s : b)
+    if (s.m > 0) s.x /= s.m, s.y /= s.m, s.vx /= s.m, s.vy /= s.m;
+  std::vector<double> L(materials, 0.0);
+  for (std::size_t p = 0; p < n; ++p) {
+    BodyState& s = b[std::size_t(mat.at(p))];
+    const double rx = x.at(p, 0) - s.x, ry = x.at(p, 1) - s.y;
+    L[std::size_t(mat.at(p))] += m.at(p) * (rx * (v.at(p, 1) - s.vy) - ry * (v.at(p, 0) - s.vx));
+    s.I += m.at(p) * (rx * rx + ry * ry);
+  }
+  for (std::size_t j = 0; j < materials; ++j)
+    if (b[j].I > 0) b[j].omega = L[j] / b[j].I;
+  return b;
+}
+
+// One line of measured values per check, for the CI log and the tables of
+// docs/contact_validation.md.
+template <class... A>
+void note(const char* fmt, A... args) {
+  std::printf("[ measured ] ");
+  std::printf(fmt, args...);
+  std::printf("\n");
+}
+
+// Least-squares slope of y(t).
 double slope(const std::vector<double>& t, const std::vector<double>& y) {
-  double st = 0, sy = 0, stt = 0, sty = 0; const double n = double(t.size());
-  for (std::size_t k = 0; k < t.size(); ++k) { st += t[k]; sy += y[k]; stt += t[k] * t[k]; sty += t[k] * y[k]; }
+  double st = 0, sy = 0, stt = 0, sty = 0;
+  const double n = double(t.size());
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    st += t[k], sy += y[k], stt += t[k] * t[k], sty += t[k] * y[k];
+  }
   return (n * sty - st * sy) / (n * stt - st * st);
 }
-TEST(ContactExplore, Incline) {
-  const char* scene = std::getenv("SCENE") ? std::getenv("SCENE") : MMPM_SOURCE_DIR "/inputs/incline_block.toml";
-  std::vector<std::string> ov;
-  if (const char* e = std::getenv("OVS")) {
-    std::string all = e; std::size_t pos = 0;
-    while (pos <= all.size()) { auto q = all.find(';', pos); if (q == std::string::npos) q = all.size(); if (q > pos) ov.push_back(all.substr(pos, q - pos)); pos = q + 1; }
+
+// ---------------------------------------------------------------------------
+// §2 Head-on impact of two identical blocks (inputs/collision.toml)
+// ---------------------------------------------------------------------------
+// Blocks 10 x 4 mm, E = 100 MPa, nu = 0, rho = 1e-3 (c = 316.2 mm/ms), plane
+// stress, A at +4 mm/ms, B at -2 mm/ms, 0.5 mm apart; h = 0.5 mm, 2 x 2
+// particles per cell, uGIMP, MUSL, FLIP. Exact (1D bar impact, §2): the
+// velocities exchange (A -> -2, B -> +4) after a contact of 2L/c = 0.0632 ms.
+
+struct CollisionRun {
+  double max_momentum_error = 0;  // max over steps of |P(t) - P(0)| / |P(0)|
+  double vA0 = 0, vB0 = 0;        // initial centre-of-mass velocities
+  double vA = 0, vB = 0;          // at the end
+  double velocity_change = 0;     // |v(end) - v(end - 0.02 ms)| of A and B: 0 once apart
+  double kinetic0 = 0;            // initial kinetic energy
+  double total_end = 0;           // kinetic + strain at the end
+  double rigid_motion_end = 0;    // sum of 1/2 M v_cm^2 at the end
+  double max_overlap = 0;         // max over steps of -(surface gap), in mm
+  double h = 0;
+};
+
+CollisionRun run_collision(const std::vector<std::string>& overrides, double t_end) {
+  const Scene scene = parse_scene_file(input("collision.toml"), overrides);
+  auto sim = make_simulation(scene);
+  CollisionRun r;
+  r.h = scene.grid.cell[0];
+  // Particle centres sit half a particle spacing inside the surfaces.
+  const double spacing = scene.grid.cell[0] / scene.bodies[0].particles_per_cell;
+  auto momentum = [&](const std::vector<BodyState>& b) {
+    return std::array<double, 2>{b[0].m * b[0].vx + b[1].m * b[1].vx, b[0].m * b[0].vy + b[1].m * b[1].vy};
+  };
+  std::vector<BodyState> b = body_states(*sim, 2);
+  const auto P0 = momentum(b);
+  const double P0n = std::hypot(P0[0], P0[1]);
+  r.vA0 = b[0].vx, r.vB0 = b[1].vx;
+  r.kinetic0 = sim->energies().kinetic;
+  double vA_before = 0, vB_before = 0;
+  bool marked = false;
+  while (sim->time() < t_end - 1e-9 * sim->dt()) {
+    sim->step();
+    b = body_states(*sim, 2);
+    const auto P = momentum(b);
+    r.max_momentum_error = std::max(r.max_momentum_error, std::hypot(P[0] - P0[0], P[1] - P0[1]) / P0n);
+    r.max_overlap = std::max(r.max_overlap, -(b[1].min_x - b[0].max_x - spacing));
+    if (!marked && sim->time() >= t_end - 0.02) {
+      vA_before = b[0].vx, vB_before = b[1].vx;
+      marked = true;
+    }
   }
-  const Scene sc = parse_scene_file(scene, ov);
-  auto sim = make_simulation(sc);
-  const double G = std::hypot(sc.loads[0].acceleration[0], sc.loads[0].acceleration[1]);
-  const double th = std::atan2(sc.loads[0].acceleration[0], -sc.loads[0].acceleration[1]);
-  const double mu = sc.interactions[0].friction;
-  int mat = 0; for (std::size_t m = 0; m < sc.materials.size(); ++m) if (sc.materials[m].type != MaterialType::rigid) mat = int(m);
-  const double tend = std::getenv("TEND") ? atof(std::getenv("TEND")) : sc.simulation.end_time;
-  const double t0 = std::getenv("T0") ? atof(std::getenv("T0")) : 0.3 * tend;
-  std::vector<double> ts, vs, xs, ws, rx, ry;
-  const Stats s0 = body_stats(*sim, mat);
-  int k = 0;
-  while (sim->time() < tend) {
-    sim->step(); ++k;
-    const Stats s = body_stats(*sim, mat);
-    Vec3 r{0, 0, 0};
-    for (const auto& q : sim->reactions()) if (q.name.rfind("rigid:", 0) == 0) r = q.force;
-    if (sim->time() >= t0) { ts.push_back(sim->time()); vs.push_back(s.vx); xs.push_back(s.x - s0.x); ws.push_back(s.Lz / s.I); rx.push_back(r[0]); ry.push_back(r[1]); }
-    if (k % 50 == 0) printf("t %.4f x %.5f y %.5f vx %.5f vy %.5f omega %.4f R %.4g %.4g mm %ld\n", sim->time(), s.x - s0.x, s.y - s0.y, s.vx, s.vy, s.Lz / s.I, r[0], r[1], sim->counters().multimaterial_nodes);
-  }
-  const double a = slope(ts, vs);
-  double mrx = 0, mry = 0; for (std::size_t i = 0; i < rx.size(); ++i) { mrx += rx[i]; mry += ry[i]; } mrx /= rx.size(); mry /= ry.size();
-  const double slide = G * (std::sin(th) - mu * std::cos(th)), roll = 2.0 / 3.0 * G * std::sin(th);
-  printf("G %.3f theta %.2f mu %.3f mass %.5g: a_fit %.4f slide %.4f (%.4f) roll %.4f (%.4f); mean R %.5g %.5g vs weight n %.5g t_slide %.5g t_stick %.5g; omega/v*? %.4f\n",
-         G, th * 180 / M_PI, mu, s0.m, a, slide, a / slide, roll, a / roll, mrx, mry, -s0.m * G * std::cos(th), s0.m * mu * G * std::cos(th), s0.m * G * std::sin(th), slope(ts, ws) / a);
+  r.vA = b[0].vx, r.vB = b[1].vx;
+  r.velocity_change = std::max(std::abs(r.vA - vA_before), std::abs(r.vB - vB_before));
+  const Energies e = sim->energies();
+  r.total_end = e.kinetic + e.strain;
+  r.rigid_motion_end = 0.5 * b[0].m * b[0].vx * b[0].vx + 0.5 * b[1].m * b[1].vx * b[1].vx;
+  return r;
 }
+
+// Exchange error: how far each block's final velocity is from the other's
+// initial one, as a fraction of the approach speed.
+double exchange_error(const CollisionRun& r) {
+  return std::max(std::abs(r.vA - r.vB0), std::abs(r.vB - r.vA0)) / std::abs(r.vA0 - r.vB0);
+}
+
+std::string law_override(const std::string& law) { return "interaction[0].law=\"" + law + "\""; }
+
+// Total momentum of the particles after every step, for stick, frictionless
+// and separate (the blocks pass through each other). Contact momentum changes
+// are equal and opposite at each node and internal forces sum to zero, so the
+// momentum is conserved to round-off: tolerance 1e-12 relative to |P(0)|
+// (h = 0.5 mm, 0.2 ms = 257 steps, through the whole impact).
+TEST(ValidationContact, HeadOnImpactConservesMomentumEveryStep) {
+  for (const char* law : {"stick", "frictionless", "separate"}) {
+    const CollisionRun r = run_collision({law_override(law)}, 0.2);
+    note("%s: max |P - P0| / |P0| = %.3e", law, r.max_momentum_error);
+    EXPECT_LT(r.max_momentum_error, 1e-12) << "law " << law;
+  }
+}
+
+// Frictionless and stick contact (identical for a head-on impact): the blocks
+// exchange their velocities within 5 % of the approach speed; the total
+// (kinetic + strain) energy after separation is within 5 % of the initial
+// kinetic energy; the kinetic energy of the blocks' rigid motion keeps at
+// least 83 % of it (what a 5 % exchange error allows, §2.3); the surfaces
+// never overlap by more than a quarter cell. h = 0.5 mm, contact plane at 2/3
+// of a cell, 0.25 ms (separation at ~0.15 ms).
+TEST(ValidationContact, HeadOnImpactExchangesVelocities) {
+  for (const char* law : {"frictionless", "stick"}) {
+    const CollisionRun r = run_collision({law_override(law)}, 0.25);
+    ASSERT_LT(r.velocity_change, 1e-6) << law << ": the blocks must have separated";
+    note("%s: vA %.4f vB %.4f, exchange error %.4f, (K+U)/K0 %.4f, rigid-motion K/K0 %.4f, overlap %.4f mm", law,
+         r.vA, r.vB, exchange_error(r), r.total_end / r.kinetic0, r.rigid_motion_end / r.kinetic0, r.max_overlap);
+    EXPECT_LT(exchange_error(r), 0.05) << law << ": vA " << r.vA << " (exact " << r.vB0 << "), vB " << r.vB
+                                       << " (exact " << r.vA0 << ")";
+    EXPECT_NEAR(r.total_end / r.kinetic0, 1.0, 0.05) << law;
+    EXPECT_GT(r.rigid_motion_end / r.kinetic0, 0.83) << law;
+    EXPECT_LT(r.max_overlap, 0.25 * r.h) << law;
+  }
+}
+
+// Without contact ("separate") the blocks pass through each other untouched:
+// both keep their velocities (to round-off, 1e-12 relative) and overlap by
+// more than 1 mm at the end. h = 0.5 mm, 0.25 ms.
+TEST(ValidationContact, HeadOnSeparateLawPassesThrough) {
+  const CollisionRun r = run_collision({law_override("separate")}, 0.25);
+  note("separate: vA %.15g vB %.15g, overlap %.4f mm, (K+U)/K0 - 1 = %.3e", r.vA, r.vB, r.max_overlap,
+       r.total_end / r.kinetic0 - 1.0);
+  EXPECT_NEAR(r.vA, r.vA0, 1e-12 * std::abs(r.vA0));
+  EXPECT_NEAR(r.vB, r.vB0, 1e-12 * std::abs(r.vB0));
+  EXPECT_GT(r.max_overlap, 1.0);
+  EXPECT_NEAR(r.total_end / r.kinetic0, 1.0, 1e-12);
+}
+
+// Where the contact plane lies in the cell must not matter: block B starts
+// 0.5, 0.75 or 1.0 mm from A, so the blocks meet at x = 12.33, 12.5 and
+// 12.67 mm, i.e. 2/3, 0 and 1/3 of a cell past a grid line. Frictionless,
+// h = 0.5 mm; each run within the 5 % exchange error of the test above, and
+// the three within 5 % of each other.
+TEST(ValidationContact, HeadOnImpactIndependentOfContactPlaneInCell) {
+  MMPM_KNOWN_LIMITATION("position separation uses the paper's fixed offset 0.8 h; the exchange error is "
+                        "2.5 / 4.3 / 10.4 % with the contact plane at 2/3, 0, 1/3 of a cell");
+  std::vector<double> errors;
+  for (double gap : {0.5, 0.75, 1.0}) {
+    const double bmin = 12.0 + gap;
+    const CollisionRun r = run_collision({law_override("frictionless"),
+                                          "body[1].min=[" + num(bmin) + ",2.0]",
+                                          "body[1].max=[" + num(bmin + 10.0) + ",6.0]"},
+                                         0.3);
+    ASSERT_LT(r.velocity_change, 1e-6) << "gap " << gap << ": the blocks must have separated";
+    errors.push_back(exchange_error(r));
+    note("gap %.2f: vA %.4f vB %.4f, exchange error %.4f, (K+U)/K0 %.4f, rigid-motion K/K0 %.4f", gap, r.vA, r.vB,
+         errors.back(), r.total_end / r.kinetic0, r.rigid_motion_end / r.kinetic0);
+    EXPECT_LT(errors.back(), 0.05) << "gap " << gap << " (contact plane at x = " << 12.0 + 4.0 * gap / 6.0
+                                   << "): vA " << r.vA << ", vB " << r.vB;
+  }
+  const auto [lo, hi] = std::minmax_element(errors.begin(), errors.end());
+  EXPECT_LT(*hi - *lo, 0.05);
+}
+
+// ---------------------------------------------------------------------------
+// §3 Block on a rigid incline, §4 disk on a rigid incline
+// ---------------------------------------------------------------------------
+// Flat rigid floor, gravity G = 200 mm/ms^2 tilted by theta = 30 degrees and
+// ramped in over 0.05 ms. The fits use 0.07 ms <= t <= 0.2 ms.
+
+struct InclineRun {
+  double G = 0, theta = 0, mu = 0, mass = 0, radius = 0;
+  double accel = 0;         // fitted d v_cm,x / dt (along the slope)
+  double spin_accel = 0;    // fitted d omega / dt
+  double slide = 0;         // centre-of-mass displacement along the slope at the end
+  double sink = 0;          // largest downward centre-of-mass displacement
+  double reaction[2] = {0, 0};  // mean force on the rigid floor over the fit window
+};
+
+InclineRun run_incline(const std::string& file, const std::vector<std::string>& overrides,
+                       double t_fit = 0.07) {
+  const Scene scene = parse_scene_file(input(file), overrides);
+  auto sim = make_simulation(scene);
+  InclineRun r;
+  const Vec3 g = scene.loads.at(0).acceleration;
+  r.G = std::hypot(g[0], g[1]);
+  r.theta = std::atan2(g[0], -g[1]);
+  r.mu = scene.interactions.at(0).friction;
+  int body = -1;
+  for (std::size_t m = 0; m < scene.materials.size(); ++m)
+    if (scene.materials[m].type != MaterialType::rigid) body = int(m);
+  const std::string floor = "rigid:floor";
+  const std::size_t nm = scene.materials.size();
+  const BodyState s0 = body_states(*sim, nm)[std::size_t(body)];
+  r.mass = s0.m;
+  r.radius = std::sqrt(2.0 * s0.I / s0.m);  // a uniform disk: I = m R^2 / 2
+  std::vector<double> t, v, w;
+  double rx = 0, ry = 0;
+  BodyState s = s0;
+  while (sim->time() < scene.simulation.end_time - 1e-9 * sim->dt()) {
+    sim->step();
+    s = body_states(*sim, nm)[std::size_t(body)];
+    r.sink = std::max(r.sink, s0.y - s.y);
+    if (sim->time() < t_fit) continue;
+    t.push_back(sim->time()), v.push_back(s.vx), w.push_back(s.omega);
+    for (const Reaction& q : sim->reactions())
+      if (q.name == floor) rx += q.force[0], ry += q.force[1];
+  }
+  r.accel = slope(t, v);
+  r.spin_accel = slope(t, w);
+  r.slide = s.x - s0.x;
+  r.reaction[0] = rx / double(t.size());
+  r.reaction[1] = ry / double(t.size());
+  note("%s mu %.2f: a %.4f (sliding %.4f, rolling %.4f), alpha %.4f, slide %.5f mm, sink %.5f mm, "
+       "floor reaction (%.5f, %.5f) N, m G = %.5f N",
+       file.c_str(), r.mu, r.accel, r.G * (std::sin(r.theta) - r.mu * std::cos(r.theta)),
+       2.0 / 3.0 * r.G * std::sin(r.theta), r.spin_accel, r.slide, r.sink, r.reaction[0], r.reaction[1],
+       r.mass * r.G);
+  return r;
+}
+
+double sliding_accel(const InclineRun& r) { return r.G * (std::sin(r.theta) - r.mu * std::cos(r.theta)); }
+
+const std::string kMidCell = "grid.origin=[0.0,-0.25]";  // floor top at cell mid-height
+const std::string kSticking = "interaction[0].friction=0.7";
+
+// mu = 0.2 < tan 30 deg: the block slides with a = G (sin theta - mu cos theta)
+// = 65.36 mm/ms^2. Block 6 x 2 mm, E = 1000 MPa, h = 0.5 mm, 2 x 2 ppc,
+// "displacement" separation, contact plane on a grid line. Tolerance 1 %.
+TEST(ValidationContact, BlockSlidesDownInclineWithCoulombFriction) {
+  const InclineRun r = run_incline("incline_block.toml", {});
+  EXPECT_NEAR(r.accel / sliding_accel(r), 1.0, 0.01) << "a = " << r.accel << ", exact " << sliding_accel(r);
+  EXPECT_LT(r.sink, 0.01 * 0.5) << "the block must stay on the floor";
+}
+
+// mu = 0.7 >= tan 30 deg = 0.577: the block must not slide. Tolerances: fitted
+// acceleration below 1 % of G sin theta; displacement along the slope below
+// 1 % of a cell (the elastic shear of the block alone is ~5e-4 mm).
+TEST(ValidationContact, BlockSticksWhenFrictionExceedsSlope) {
+  const InclineRun r = run_incline("incline_block.toml", {kSticking});
+  EXPECT_LT(std::abs(r.accel), 0.01 * r.G * std::sin(r.theta));
+  EXPECT_LT(std::abs(r.slide), 0.01 * 0.5);
+}
+
+// The force on the rigid floor (reactions() "rigid:floor", averaged over the
+// fit window) is what the block presses on it: sliding, (mu, -1) m G cos theta;
+// sticking, (sin theta, -cos theta) m G. Momentum balance of the block makes
+// this exact once its acceleration is right (§3.3). Tolerance 1 %.
+TEST(ValidationContact, RigidFloorReactionEqualsBlockLoad) {
+  {
+    const InclineRun r = run_incline("incline_block.toml", {});
+    const double n = r.mass * r.G * std::cos(r.theta);
+    EXPECT_NEAR(r.reaction[0] / (r.mu * n), 1.0, 0.01) << "sliding: tangential " << r.reaction[0] << ", exact " << r.mu * n;
+    EXPECT_NEAR(r.reaction[1] / -n, 1.0, 0.01) << "sliding: normal " << r.reaction[1] << ", exact " << -n;
+  }
+  {
+    const InclineRun r = run_incline("incline_block.toml", {kSticking});
+    const double W = r.mass * r.G;
+    EXPECT_NEAR(r.reaction[0] / (W * std::sin(r.theta)), 1.0, 0.01)
+        << "sticking: tangential " << r.reaction[0] << ", exact " << W * std::sin(r.theta);
+    EXPECT_NEAR(r.reaction[1] / (-W * std::cos(r.theta)), 1.0, 0.01)
+        << "sticking: normal " << r.reaction[1] << ", exact " << -W * std::cos(r.theta);
+  }
+}
+
+// The same two runs with the grid shifted by half a cell, so that the floor
+// top lies at cell mid-height instead of on a grid line: the sliding
+// acceleration within 1 % of the grid-line run (and of the exact value), the
+// block still sticks at mu = 0.7. "displacement" separation (the scene's).
+TEST(ValidationContact, BlockOnInclineIndependentOfContactPlaneInCell) {
+  const InclineRun line = run_incline("incline_block.toml", {});
+  const InclineRun mid = run_incline("incline_block.toml", {kMidCell});
+  EXPECT_NEAR(mid.accel / line.accel, 1.0, 0.01) << "grid line " << line.accel << ", mid-cell " << mid.accel;
+  EXPECT_NEAR(mid.accel / sliding_accel(mid), 1.0, 0.01);
+  EXPECT_LT(mid.sink, 0.01 * 0.5);
+  const InclineRun stick = run_incline("incline_block.toml", {kMidCell, kSticking});
+  EXPECT_LT(std::abs(stick.slide), 0.01 * 0.5);
+}
+
+// The same with the "position" separation method (ALGORITHM §3: contact when
+// delta_n - 0.8 h < 0), which a block resting on a floor may also use: on a
+// grid line and at cell mid-height the block slides at the exact
+// acceleration (1 %) without sinking more than 2 % of a cell, and sticks at
+// mu = 0.7 (slide below 1 % of a cell).
+TEST(ValidationContact, BlockOnInclinePositionSeparationIndependentOfContactPlaneInCell) {
+  MMPM_KNOWN_LIMITATION("position separation with the fixed 0.8 h offset: at mid-cell the block sinks "
+                        "0.035 mm and slides 0.53 mm at mu = 0.7 (the displacement method passes)");
+  const std::string position = "interaction[0].separation=\"position\"";
+  for (const std::string& where : {std::string("grid.origin=[0.0,0.0]"), kMidCell}) {
+    const InclineRun slide = run_incline("incline_block.toml", {position, where});
+    EXPECT_NEAR(slide.accel / sliding_accel(slide), 1.0, 0.01) << where;
+    EXPECT_LT(slide.sink, 0.02 * 0.5) << where;
+    const InclineRun stick = run_incline("incline_block.toml", {position, where, kSticking});
+    EXPECT_LT(std::abs(stick.slide), 0.01 * 0.5) << where;
+  }
+}
+
+// Disk R = 3 mm, E = 100 MPa (contact half-width ~0.4 mm, about a cell),
+// h = 0.5 mm (6 cells per radius), 2 x 2 ppc, "position" separation.
+// mu = 0.5 >= tan(theta)/3: rolls without slipping, a = (2/3) G sin theta =
+// 66.67 mm/ms^2 within 10 % (the disk is rough at 6 cells per radius) and the
+// rolling constraint alpha R = -a within 5 %.
+TEST(ValidationContact, DiskRollsWithoutSlipping) {
+  const InclineRun r = run_incline("incline_disk.toml", {});
+  const double roll = 2.0 / 3.0 * r.G * std::sin(r.theta);
+  EXPECT_NEAR(r.accel / roll, 1.0, 0.10) << "a = " << r.accel << ", rolling " << roll;
+  EXPECT_NEAR(r.spin_accel * r.radius / r.accel, -1.0, 0.05)
+      << "alpha R = " << r.spin_accel * r.radius << ", a = " << r.accel;
+}
+
+// mu = 0.05 < tan(theta)/3: slides with a = G (sin theta - mu cos theta) =
+// 91.34 mm/ms^2 (within 5 %) while friction spins it up at
+// alpha = -2 mu G cos(theta) / R (within 10 %), slower than rolling would need.
+TEST(ValidationContact, DiskSlidesWhenFrictionIsLow) {
+  MMPM_KNOWN_LIMITATION("the sliding disk's spin-up is 51 % of mu m g cos(theta) R / I with MUSL "
+                        "(linear acceleration within 1 %); cause not isolated");
+  const InclineRun r = run_incline("incline_disk.toml", {"interaction[0].friction=0.05"});
+  EXPECT_NEAR(r.accel / sliding_accel(r), 1.0, 0.05) << "a = " << r.accel << ", exact " << sliding_accel(r);
+  const double alpha = -2.0 * r.mu * r.G * std::cos(r.theta) / r.radius;
+  EXPECT_NEAR(r.spin_accel / alpha, 1.0, 0.10) << "alpha = " << r.spin_accel << ", exact " << alpha;
+  EXPECT_LT(std::abs(r.spin_accel) * r.radius, 0.5 * r.accel) << "it must slip";
+}
+
+// ---------------------------------------------------------------------------
+// Refinement (ctest -L long)
+// ---------------------------------------------------------------------------
+
+// Velocity exchange at h = 0.25 and 0.125 mm (4 and 8 particles per mm),
+// same geometry, frictionless: within 5 % like the CI run, and momentum to
+// round-off (1e-12). Runs ~1 min.
+TEST(ValidationContactLong, HeadOnImpactRefined) {
+  MMPM_LONG_TEST();
+  for (double h : {0.25, 0.125}) {
+    const int nx = int(std::lround(25.0 / h)), ny = int(std::lround(8.0 / h));
+    const CollisionRun r = run_collision({law_override("frictionless"), "grid.cell=[" + num(h) + "," + num(h) + "]",
+                                          "grid.cells=[" + std::to_string(nx) + "," + std::to_string(ny) + "]"},
+                                         0.25);
+    ASSERT_LT(r.velocity_change, 1e-6) << "h " << h;
+    note("h %.3f: vA %.4f vB %.4f, exchange error %.4f, (K+U)/K0 %.4f, momentum %.3e", h, r.vA, r.vB,
+         exchange_error(r), r.total_end / r.kinetic0, r.max_momentum_error);
+    EXPECT_LT(exchange_error(r), 0.05) << "h " << h << ": vA " << r.vA << ", vB " << r.vB;
+    EXPECT_NEAR(r.total_end / r.kinetic0, 1.0, 0.05) << "h " << h;
+    EXPECT_LT(r.max_momentum_error, 1e-12) << "h " << h;
+  }
+}
+
+// Disk at h = 0.25 and 0.125 mm (12 and 24 cells per radius): rolling a
+// within 10 % and the rolling constraint within 5 %; sliding a within 5 % and
+// its spin-up within 10 %. Runs ~75 s (h = 0.125 mm: 7000 disk particles).
+TEST(ValidationContactLong, DiskOnInclineRefined) {
+  MMPM_LONG_TEST();
+  for (double h : {0.25, 0.125}) {
+    const std::vector<std::string> fine = {"grid.cell=[" + num(h) + "," + num(h) + "]",
+                                           "grid.cells=[" + std::to_string(int(std::lround(16.0 / h))) + "," +
+                                               std::to_string(int(std::lround(11.0 / h))) + "]"};
+    const InclineRun roll = run_incline("incline_disk.toml", fine);
+    const double a_roll = 2.0 / 3.0 * roll.G * std::sin(roll.theta);
+    EXPECT_NEAR(roll.accel / a_roll, 1.0, 0.10) << "h " << h << ": a = " << roll.accel << ", rolling " << a_roll;
+    EXPECT_NEAR(roll.spin_accel * roll.radius / roll.accel, -1.0, 0.05) << "h " << h;
+    auto low = fine;
+    low.push_back("interaction[0].friction=0.05");
+    const InclineRun slide = run_incline("incline_disk.toml", low);
+    EXPECT_NEAR(slide.accel / sliding_accel(slide), 1.0, 0.05) << "h " << h;
+    const double alpha = -2.0 * slide.mu * slide.G * std::cos(slide.theta) / slide.radius;
+    EXPECT_NEAR(slide.spin_accel / alpha, 1.0, 0.10)
+        << "h " << h << ": alpha = " << slide.spin_accel << ", exact " << alpha;
+  }
+}
+
 }  // namespace
 }  // namespace mmpm

@@ -156,6 +156,9 @@ TEST(ValidationInterface, SeriesBarsNormalCompliance) {
     const BarsResult r = run_bars(Dn, sigma, h, 1.0);
     const auto ex = analytic::series_bars(E, 5.0, E, 5.0, Dn, A, sigma * A);
     SCOPED_TRACE("Dn = " + num(Dn));
+    std::printf("[bars h=0.5] Dn %-8g compliance %+.3f %%  opening %.5g (continuum %.5g)  U_int/exact %.4f\n", Dn,
+                100 * (r.compliance / ex.compliance - 1), r.jump, ex.jump,
+                std::isinf(Dn) ? 0.0 : r.e.interface / ex.U_interface);
     EXPECT_TRUE(finite(r.e));
     EXPECT_LT(r.e.kinetic, 1e-5 * (r.e.strain + r.e.interface)) << "not static";
     EXPECT_NEAR(r.compliance / ex.compliance, 1.0, 0.015)
@@ -238,6 +241,9 @@ TEST(ValidationInterface, ShearStackTangentialCompliance) {
     const ShearResult r = run_shear(Dt, tau, 0.8);
     const auto ex = analytic::shear_stack(G1, 2.0, G2, 2.0, Dt, tau);
     SCOPED_TRACE("Dt = " + num(Dt));
+    std::printf("[shear h=0.5] Dt %-8g u_top %+.3f %%  slip %.5g (continuum %.5g)  U_int/exact %.4f\n", Dt,
+                100 * (r.top / ex.top_displacement - 1), r.jump, ex.jump,
+                std::isinf(Dt) ? 0.0 : r.e.interface / (ex.U_interface_per_area * W));
     EXPECT_TRUE(finite(r.e));
     EXPECT_LT(r.e.kinetic, 1e-5 * (r.e.strain + r.e.interface)) << "not static";
     const double model_top = ex.top_displacement - (std::isinf(Dt) ? 0.0 : tau * bias);
@@ -292,6 +298,8 @@ TEST(ValidationInterface, DlsStiffnessVsShearLag) {
     const DlsRun r = run_dls(1.0 / inv, 0.5, 0.25);
     const auto ex = analytic::DlsShearLag({}, {}, 1.0 / inv).result();
     SCOPED_TRACE("1/Dt = " + num(inv));
+    std::printf("[dls h=0.5] 1/Dt %.2f  k %.2f  shear lag %.2f (%+.2f %%)  interface share %.4f (theory %.4f)\n", inv,
+                r.k, ex.k, 100 * (r.k / ex.k - 1), r.interface_fraction, ex.interface_fraction);
     EXPECT_TRUE(finite(r.e));
     EXPECT_NEAR(r.k / ex.k, 1.0, 0.02) << "k = " << r.k << " shear lag " << ex.k;
     EXPECT_NEAR(r.interface_fraction, ex.interface_fraction, 0.01);
@@ -420,6 +428,9 @@ TEST(ValidationInterface, ExtremesStableWithForceLimit) {
   for (double D : {analytic::kInf, 1e12, 1e9, 1e6, 1e3, 1.0, 1e-3}) {
     SCOPED_TRACE("D = " + num(D));
     const ExtremeRun r = run_extreme(D, true, "explicit", 0.4);
+    std::printf("[extremes, force limit] D %-8g threw %d  U %.4g (static %.4g)  U_int %.3g  C/C_perfect %.5f  limited %ld\n",
+                D, int(r.threw), r.e.strain + r.e.interface, analytic::series_bars(E, 5, E, 5, D, A, P).U_total,
+                r.e.interface, r.compliance / C_perfect, r.limited);
     ASSERT_FALSE(r.threw) << r.message;
     ASSERT_TRUE(finite(r.e));
     const auto ex = analytic::series_bars(E, 5, E, 5, D, A, P);
@@ -444,6 +455,8 @@ TEST(ValidationInterface, ExtremesUnstableWithoutForceLimit) {
     SCOPED_TRACE("D = " + num(D));
     const ExtremeRun r = run_extreme(D, false, "explicit", 0.05);
     const auto ex = analytic::series_bars(E, 5, E, 5, D, A, P);
+    std::printf("[extremes, no limit] D %-8g threw %d (%s)  U %.4g\n", D, int(r.threw), r.message.substr(0, 60).c_str(),
+                r.e.strain + r.e.interface + r.e.kinetic);
     const bool blew_up = r.threw || !finite(r.e) ||
                          r.e.strain + r.e.interface + r.e.kinetic > 10 * ex.U_total;
     EXPECT_TRUE(blew_up) << "energy " << r.e.strain + r.e.interface + r.e.kinetic << " static " << ex.U_total;
@@ -462,6 +475,8 @@ TEST(ValidationInterface, ExtremesExactIntegrationStable) {
   for (double D : {1e12, 1e6}) {
     SCOPED_TRACE("D = " + num(D));
     const ExtremeRun r = run_extreme(D, false, "exact", 0.4);
+    std::printf("[extremes, exact] D %-8g threw %d  C/C_perfect %.5f  limited %ld\n", D, int(r.threw),
+                r.compliance / C_perfect, r.limited);
     ASSERT_FALSE(r.threw) << r.message;
     ASSERT_TRUE(finite(r.e));
     EXPECT_NEAR(r.compliance / C_perfect, 1.0, 0.005);

@@ -72,9 +72,17 @@ class MultimaterialStage {
     stats_.reset(fields_);
     multimaterial_pass_a(grid, list_, cfg_, stats_, stick_flags_);
   }
-  void pass_b(GridView<D, Real>& grid) {
+  // record_reactions = false for MUSL's repeat of pass B on the
+  // re-extrapolated momenta: the step's impulse on rigid bodies is already counted.
+  void pass_b(GridView<D, Real>& grid, bool record_reactions = true) {
     if (!enabled_) return;
+    if (record_reactions) {
+      multimaterial_pass_b(grid, list_, cfg_, stick_flags_, stats_);
+      return;
+    }
+    const auto kept = stats_.rigid_reaction;
     multimaterial_pass_b(grid, list_, cfg_, stick_flags_, stats_);
+    stats_.rigid_reaction = kept;
   }
 
   StepCounters counters() const {

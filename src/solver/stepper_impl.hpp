@@ -309,7 +309,13 @@ void Stepper<D, Shape, Real>::apply_boundaries(bool with_dvel) {
       for (std::uint32_t node : bc.nodes) {
         const std::size_t i = o + node;
         const Real m = G_.m[i];
-        if (!(m > mass_threshold_)) continue;
+        if (!(m > mass_threshold_)) {
+          // A sliver node on a support: the support absorbs its increment.
+          if (with_dvel)
+            for (int d = 0; d < D; ++d)
+              if (bc.fix[d]) GV_.dvel[d][i] = Real(0);
+          continue;
+        }
         for (int d = 0; d < D; ++d) {
           if (!bc.fix[d]) continue;
           const Real v_target = Real(vb[d]);
@@ -458,7 +464,7 @@ void Stepper<D, Shape, Real>::step() {
     toc(kStageP2G);
     if (mm) {
       tic();
-      mm_.pass_b(G_);
+      mm_.pass_b(G_, false);
       toc(kStageMultimaterial);
     }
     tic();
