@@ -88,6 +88,29 @@ inline double& time_scale() {
 }
 inline double min_time(double seconds) { return seconds * time_scale(); }
 
+// Repetitions of every benchmark (--quick: 1). The table reads the minimum
+// over them for the headline times (the least disturbed run on a shared
+// machine) and the median for breakdown counters.
+inline int& repetitions() {
+  static int reps = 3;
+  return reps;
+}
+inline double stat_min(const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); }
+inline double stat_max(const std::vector<double>& v) { return *std::max_element(v.begin(), v.end()); }
+
+// Minimum time and repetitions of one registered benchmark.
+inline benchmark::internal::Benchmark* configure(benchmark::internal::Benchmark* b,
+                                                 double seconds, int reps = 0) {
+  if (reps <= 0 || repetitions() == 1) reps = repetitions();
+  b->MinTime(min_time(seconds));
+  if (reps > 1)
+    b->Repetitions(reps)
+        ->ReportAggregatesOnly(true)
+        ->ComputeStatistics("min", stat_min)
+        ->ComputeStatistics("max", stat_max);
+  return b;
+}
+
 // benchmark::DoNotOptimize through a const reference: the value is an asm
 // input, never rewritten. (The non-const overload of Google Benchmark 1.7.1
 // uses an "+m,r" constraint that GCC miscompiles for doubles: google/benchmark

@@ -142,9 +142,10 @@ void register_g2p_case() {
   for (int threads : {1, 2}) {
     const std::string name = "g2p/dim:" + std::to_string(D) + "/shape:" + Shape::name +
                              "/real:" + real_name<Real>() + "/threads:" + std::to_string(threads);
-    benchmark::RegisterBenchmark(name.c_str(), [threads](benchmark::State& st) {
+    auto* b = benchmark::RegisterBenchmark(name.c_str(), [threads](benchmark::State& st) {
       bm_g2p<D, Shape, Real>(st, threads);
-    })->UseRealTime()->MinTime(min_time(0.2))->Unit(benchmark::kMillisecond);
+    });
+    configure(b->UseRealTime()->Unit(benchmark::kMillisecond), 0.1);
   }
 }
 
@@ -157,9 +158,10 @@ void register_dim_real() {
   for (int threads : {1, 2}) {
     const std::string name = "constitutive/dim:" + std::to_string(D) + "/law:isotropic/real:" +
                              real_name<Real>() + "/threads:" + std::to_string(threads);
-    benchmark::RegisterBenchmark(name.c_str(), [threads](benchmark::State& st) {
+    auto* b = benchmark::RegisterBenchmark(name.c_str(), [threads](benchmark::State& st) {
       bm_constitutive<D, Real>(st, threads);
-    })->UseRealTime()->MinTime(min_time(0.2))->Unit(benchmark::kMillisecond);
+    });
+    configure(b->UseRealTime()->Unit(benchmark::kMillisecond), 0.1);
   }
 }
 

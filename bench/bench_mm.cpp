@@ -206,9 +206,10 @@ void register_dim() {
         const std::string name = "mm/dim:" + std::to_string(D) + "/law:" + law_name(law) +
                                  "/normal:" + normal_name(normal) + "/real:double/threads:" +
                                  std::to_string(threads);
-        benchmark::RegisterBenchmark(name.c_str(), [law, normal, threads](benchmark::State& st) {
+        auto* b = benchmark::RegisterBenchmark(name.c_str(), [law, normal, threads](benchmark::State& st) {
           bm_mm<D, double>(st, law, normal, threads);
-        })->UseManualTime()->MinTime(min_time(0.08))->Unit(benchmark::kMicrosecond);
+        });
+        configure(b->UseManualTime()->Unit(benchmark::kMicrosecond), 0.05);
       }
 }
 

@@ -113,9 +113,10 @@ void bm_mm_scene(benchmark::State& state, int threads) {
 void register_mm_scene() {
   for (int threads : {1, 2}) {
     const std::string name = "mm_scene/scene:2d_gimp_interface/threads:" + std::to_string(threads);
-    benchmark::RegisterBenchmark(name.c_str(), [threads](benchmark::State& st) {
+    auto* b = benchmark::RegisterBenchmark(name.c_str(), [threads](benchmark::State& st) {
       bm_mm_scene(st, threads);
-    })->UseManualTime()->MinTime(min_time(0.2))->Unit(benchmark::kMicrosecond);
+    });
+    configure(b->UseManualTime()->Unit(benchmark::kMicrosecond), 0.1);
   }
 }
 

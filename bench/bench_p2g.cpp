@@ -122,9 +122,10 @@ void register_case() {
     std::string name = base + strategy_name(s);
     if (s == Strategy::colored) name += "/tile:" + std::to_string(tile);
     name += "/threads:" + std::to_string(threads);
-    benchmark::RegisterBenchmark(name.c_str(), [s, tile, threads](benchmark::State& st) {
+    auto* b = benchmark::RegisterBenchmark(name.c_str(), [s, tile, threads](benchmark::State& st) {
       bm_p2g<D, Shape, Real>(st, s, tile, threads);
-    })->UseRealTime()->MinTime(min_time(0.2))->Unit(benchmark::kMillisecond);
+    });
+    configure(b->UseRealTime()->Unit(benchmark::kMillisecond), 0.1);
   };
   const int T = kDefaultTile<D>;
   add(Strategy::serial, T, 1);
@@ -144,9 +145,10 @@ void register_tiles() {
       const std::string name = "p2g_tile/dim:" + std::to_string(D) + "/shape:" + Shape::name +
                                "/real:" + real_name<Real>() + "/strategy:colored/tile:" +
                                std::to_string(tile) + "/threads:" + std::to_string(threads);
-      benchmark::RegisterBenchmark(name.c_str(), [tile, threads](benchmark::State& st) {
+      auto* b = benchmark::RegisterBenchmark(name.c_str(), [tile, threads](benchmark::State& st) {
         bm_p2g<D, Shape, Real>(st, Strategy::colored, tile, threads);
-      })->UseRealTime()->MinTime(min_time(0.2))->Unit(benchmark::kMillisecond);
+      });
+      configure(b->UseRealTime()->Unit(benchmark::kMillisecond), 0.1);
     }
 }
 

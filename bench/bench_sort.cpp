@@ -122,9 +122,10 @@ void register_case() {
       const std::string name = "sort/dim:" + std::to_string(D) + "/shape:gimp/real:" +
                                real_name<Real>() + "/order:" + (shuffled ? "random" : "sorted") +
                                "/threads:" + std::to_string(threads);
-      benchmark::RegisterBenchmark(name.c_str(), [shuffled, threads](benchmark::State& st) {
+      auto* b = benchmark::RegisterBenchmark(name.c_str(), [shuffled, threads](benchmark::State& st) {
         bm_sort<D, Real>(st, shuffled, threads);
-      })->UseManualTime()->MinTime(min_time(0.2))->Unit(benchmark::kMillisecond);
+      });
+      configure(b->UseManualTime()->Unit(benchmark::kMillisecond), 0.1);
     }
 }
 

@@ -230,7 +230,7 @@ void bm_step(benchmark::State& state, const StepCase& c, int threads) {
   }
 }
 
-void add(const StepCase& c, int threads, int repetitions = 1) {
+void add(const StepCase& c, int threads, int reps = 0) {
   std::string name = "step/scene:" + c.scene;
   for (const auto& o : c.overrides) {
     // "simulation.sort_every=10" -> "/sort_every:10"
@@ -243,8 +243,7 @@ void add(const StepCase& c, int threads, int repetitions = 1) {
   auto* b = benchmark::RegisterBenchmark(name.c_str(), [c, threads](benchmark::State& st) {
     bm_step(st, c, threads);
   });
-  b->UseRealTime()->MinTime(min_time(1.0))->Unit(benchmark::kMillisecond);
-  if (repetitions > 1) b->Repetitions(repetitions)->ReportAggregatesOnly(true);
+  configure(b->UseRealTime()->Unit(benchmark::kMillisecond), 0.6, reps);
 }
 
 }  // namespace

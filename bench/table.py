@@ -33,10 +33,15 @@ def parse_name(name):
     return info
 
 
+# Headline times: the minimum over the repetitions (the least disturbed run on
+# a shared machine). Every other counter (stage breakdowns, node counts): the median.
+PRIMARY = {"ns_per_particle", "ns_per_mm_node"}
+
+
 def load(path):
     with open(path) as f:
         data = json.load(f)
-    runs = {}  # key (tuple of name items) -> dict of values
+    runs = {}  # key (sorted name items) -> {"info", "stats": {aggregate name or "single": run}}
     errors = []
     for b in data.get("benchmarks", []):
         name = b.get("run_name", b["name"])
@@ -45,15 +50,11 @@ def load(path):
             continue
         info = parse_name(name)
         key = tuple(sorted(info.items()))
-        rec = runs.setdefault(key, {"info": info})
+        rec = runs.setdefault(key, {"info": info, "stats": {}})
         if b.get("run_type") == "aggregate":
-            agg = b.get("aggregate_name")
-            if agg == "median":
-                rec["values"] = b
-            elif agg == "cv":
-                rec["cv"] = b
+            rec["stats"][b.get("aggregate_name")] = b
         else:
-            rec.setdefault("values", b)
+            rec["stats"].setdefault("single", b)
     return data.get("context", {}), runs, errors
 
 
@@ -66,21 +67,37 @@ class Results:
         want = {k: str(v) for k, v in want.items()}
         want["family"] = family
         for rec in self.runs.values():
-            if rec["info"] == want and "values" in rec:
+            if rec["info"] == want and rec["stats"]:
                 return rec
         return None
 
-    def value(self, family, counter, **want):
+    def value(self, family, counter, stat=None, **want):
         rec = self.find(family, **want)
         if rec is None:
             return None
-        return rec["values"].get(counter)
+        stats = rec["stats"]
+        if "single" in stats:
+            return stats["single"].get(counter)
+        if stat is None:
+            stat = "min" if counter in PRIMARY else "median"
+        run = stats.get(stat) or stats.get("median")
+        return None if run is None else run.get(counter)
 
-    def cv(self, family, counter, **want):
+    def spread(self, family, counter, **want):
+        """(max - min) / min over the repetitions, or None for a single run."""
+        lo = self.value(family, counter, stat="min", **want)
+        hi = self.value(family, counter, stat="max", **want)
         rec = self.find(family, **want)
-        if rec is None or "cv" not in rec:
+        if rec is None or "single" in rec["stats"] or lo in (None, 0) or hi is None:
             return None
-        return rec["cv"].get(counter)
+        return (hi - lo) / lo
+
+    def repetitions(self):
+        for rec in self.runs.values():
+            for b in rec["stats"].values():
+                if b.get("run_type") == "aggregate":
+                    return b.get("repetitions")
+        return 1
 
 
 def core_share(runs):
@@ -88,7 +105,7 @@ def core_share(runs):
     share of a core they got (1.0 on an idle machine)."""
     shares = []
     for rec in runs.values():
-        b = rec.get("values")
+        b = rec["stats"].get("single") or rec["stats"].get("median")
         if not b or rec["info"].get("threads") != "1" or "manual_time" in b.get("name", ""):
             continue
         if b.get("real_time", 0) > 0:
@@ -244,8 +261,8 @@ def step_section(R):
            "make_simulation(parse_scene_text(...)), step() in the loop, the solver's default scheme "
            "(MUSL: a second, momentum-only transfer and a second G2P) unless noted. Stage columns "
            "are the Stepper's own timers (1 thread), ns/particle/step.", ""]
-    header = ["scene", "particles", "fields", "1 thread", "2 threads", "speed-up"] + \
-             [s + " (1t)" for s in STAGES]
+    header = ["scene", "particles", "fields", "1 thread", "spread", "2 threads", "spread",
+              "speed-up"] + [s + " (1t)" for s in STAGES]
     rows = []
     for scene, label in STEP_SCENES:
         kw = {"scene": scene}
@@ -259,8 +276,9 @@ def step_section(R):
         n = R.value("step", "particles", threads=1, **kw) or R.value("step", "particles", threads=2, **kw)
         fields = R.value("step", "fields", threads=1, **kw)
         stages = [fmt(R.value("step", f"stage_{s}_ns_per_particle", threads=1, **kw)) for s in STAGES]
-        rows.append([f"`{scene}`: {label}", fmt(n, 0), fmt(fields, 0), fmt(v1), fmt(v2),
-                     ratio(v1, v2)] + stages)
+        rows.append([f"`{scene}`: {label}", fmt(n, 0), fmt(fields, 0), fmt(v1),
+                     pct(R.spread("step", ns, threads=1, **kw)), fmt(v2),
+                     pct(R.spread("step", ns, threads=2, **kw)), ratio(v1, v2)] + stages)
     out.append(table(header, rows))
     for kw, what in (({}, "default scheme"), ({"scheme": "USL"}, "USL")):
         lin = R.value("step", ns, scene="2d_linear_1mat", threads=1, **kw)
@@ -323,9 +341,10 @@ def mm_section(R):
 def unused_section(R):
     ns = "ns_per_particle"
     out = ["## 5. Unused features cost nothing", "",
-           "Same two-box geometry, supports and traction as the two-layer scene. Median of 5 "
-           "repetitions; cv = their coefficient of variation (the noise).", ""]
-    header = ["threads", "1 material (baseline)", "cv", "2 materials, shared field", "cv",
+           "Same two-box geometry, supports and traction as the two-layer scene, 5 repetitions "
+           "each (minimum shown); spread = (max − min)/min over the repetitions, i.e. the noise "
+           "a difference has to beat.", ""]
+    header = ["threads", "1 material (baseline)", "spread", "2 materials, shared field", "spread",
               "difference", "with the interface (2 fields + mm pass)"]
     rows = []
     for th in (1, 2):
@@ -333,8 +352,8 @@ def unused_section(R):
         b = R.value("step", ns, scene="2d_gimp_2mat_shared", threads=th)
         if a is None and b is None:
             continue
-        ca = R.cv("step", ns, scene="2d_gimp_1mat", threads=th)
-        cb = R.cv("step", ns, scene="2d_gimp_2mat_shared", threads=th)
+        ca = R.spread("step", ns, scene="2d_gimp_1mat", threads=th)
+        cb = R.spread("step", ns, scene="2d_gimp_2mat_shared", threads=th)
         diff = "–" if a is None or b is None else f"{100 * (b - a) / a:+.1f} %"
         c = R.value("step", ns, scene="2d_gimp_interface", threads=th)
         rows.append([str(th), fmt(a), pct(ca), fmt(b), pct(cb), diff,
@@ -422,7 +441,11 @@ def main():
              + (f"; after the run: {args.load_after}" if args.load_after else ""),
              "- Times are wall-clock (UseRealTime, or a manual timer where state is restored "
              "between iterations). The machine has 2 cores: 2-thread numbers are only meaningful "
-             "when nothing else runs (see the load average)."]
+             "when nothing else runs (see the load average).",
+             f"- Each benchmark ran {R.repetitions()} time(s): headline times (ns/particle, "
+             "ns/node) are the minimum over the repetitions, the least disturbed run on a shared "
+             "machine; breakdown counters (stages, find/A/B) are medians, so they need not add "
+             "up exactly to the headline."]
     share, count = core_share(runs)
     if share is not None:
         lines.append(f"- CPU share: the {count} single-thread wall-clock benchmarks got a median "
