@@ -93,14 +93,15 @@ def sphere_error(run_dir):
     sc = scene_of(run_dir)
     e = summary(run_dir)["energy"]
     U = e["strain"] + e["interface"]
-    glass, poly = sc["material"][1], sc["material"][0]
+    mats = {m["name"]: m for m in sc["material"]}
+    glass, poly = mats["glass"], mats["polymer"]
     l = 1.0
     eps0 = None
     for b in sc["boundary"]:
         disp = b.get("displacement")
         if disp and max(abs(v) for v in disp) > 0:
             eps0 = max(abs(v) for v in disp) / l
-    a = sc["body"][1]["radius"]
+    a = next(b for b in sc["body"] if b["shape"] == "sphere")["radius"]
     phi = math.pi * a ** 3 / 6.0 / l ** 3
     D = sc["interaction"][0]["Dn"]
     D = math.inf if D == "perfect" else float(D)
