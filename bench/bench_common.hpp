@@ -88,26 +88,14 @@ inline double& time_scale() {
 }
 inline double min_time(double seconds) { return seconds * time_scale(); }
 
-// Repetitions of every benchmark (--quick: 1). The table reads the minimum
-// over them for the headline times (the least disturbed run on a shared
-// machine) and the median for breakdown counters.
-inline int& repetitions() {
-  static int reps = 3;
-  return reps;
-}
-inline double stat_min(const std::vector<double>& v) { return *std::min_element(v.begin(), v.end()); }
-inline double stat_max(const std::vector<double>& v) { return *std::max_element(v.begin(), v.end()); }
-
-// Minimum time and repetitions of one registered benchmark.
+// Minimum time of one registered benchmark. Each benchmark runs once per
+// process; bench/run runs the whole binary several times (passes, minutes
+// apart) and bench/table.py takes the minimum over the passes for headline
+// times: on a shared machine, load from other jobs comes in bursts, and
+// back-to-back repetitions would all fall into the same burst.
 inline benchmark::internal::Benchmark* configure(benchmark::internal::Benchmark* b,
-                                                 double seconds, int reps = 0) {
-  if (reps <= 0 || repetitions() == 1) reps = repetitions();
+                                                 double seconds) {
   b->MinTime(min_time(seconds));
-  if (reps > 1)
-    b->Repetitions(reps)
-        ->ReportAggregatesOnly(true)
-        ->ComputeStatistics("min", stat_min)
-        ->ComputeStatistics("max", stat_max);
   return b;
 }
 

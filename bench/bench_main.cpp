@@ -10,12 +10,11 @@
 #include "bench/bench_common.hpp"
 
 int main(int argc, char** argv) {
-  // --quick: one repetition at half the minimum time (a fast look; bench/run --quick).
+  // --quick: half the minimum times (a fast look; bench/run --quick).
   std::vector<char*> args;
   for (int i = 0; i < argc; ++i) {
     if (std::strcmp(argv[i], "--quick") == 0) {
       mmpm::bench::time_scale() = 0.5;
-      mmpm::bench::repetitions() = 1;
     } else {
       args.push_back(argv[i]);
     }

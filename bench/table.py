@@ -1,11 +1,13 @@
 #!/usr/bin/python3
 """Turns mmpm_bench's JSON (Google Benchmark 1.7.1) into Markdown tables.
 
-    bench/table.py [bench/results.json] [-o bench/RESULTS.md] [--load-after "..."]
+    bench/table.py [bench/results.json] [-o bench/RESULTS.md]
+    bench/table.py --merge OUT.json PASS1.json [PASS2.json ...] [--loads FILE]
 
-Benchmark names are "family/key:value/..." (see bench/bench_common.hpp);
-aggregates of repeated runs are read through their median (and cv for the
-noise). Standard library only.
+Benchmark names are "family/key:value/..." (see bench/bench_common.hpp).
+bench/run runs the binary once per pass and merges the passes (--merge);
+every benchmark then has one sample per pass: headline times are the minimum
+over the samples, breakdown counters the median. Standard library only.
 """
 
 import argparse
@@ -33,28 +35,48 @@ def parse_name(name):
     return info
 
 
-# Headline times: the minimum over the repetitions (the least disturbed run on
-# a shared machine). Every other counter (stage breakdowns, node counts): the median.
+# Headline times: the minimum over the samples (passes; the least disturbed run
+# on a shared machine). Every other counter (stage breakdowns, node counts): the median.
 PRIMARY = {"ns_per_particle", "ns_per_mm_node"}
 
 
+def merge(out_path, pass_paths, loads_path=None):
+    """One JSON from several passes: every benchmark entry kept, tagged with its pass."""
+    merged = {"context": None, "benchmarks": []}
+    for k, path in enumerate(pass_paths, 1):
+        with open(path) as f:
+            data = json.load(f)
+        if merged["context"] is None:
+            merged["context"] = data.get("context", {})
+        for b in data.get("benchmarks", []):
+            b["pass"] = k
+            merged["benchmarks"].append(b)
+    ctx = merged["context"] or {}
+    ctx["passes"] = len(pass_paths)
+    if loads_path:
+        with open(loads_path) as f:
+            ctx["pass_load_averages"] = [line.strip() for line in f if line.strip()]
+    merged["context"] = ctx
+    with open(out_path, "w") as f:
+        json.dump(merged, f, indent=1)
+
+
 def load(path):
+    """Samples per benchmark: every non-aggregate entry (one per pass or repetition)."""
     with open(path) as f:
         data = json.load(f)
-    runs = {}  # key (sorted name items) -> {"info", "stats": {aggregate name or "single": run}}
+    runs = {}  # key (sorted name items) -> {"info", "samples": [entries]}
     errors = []
     for b in data.get("benchmarks", []):
         name = b.get("run_name", b["name"])
         if b.get("error_occurred"):
             errors.append((name, b.get("error_message", "")))
             continue
+        if b.get("run_type") == "aggregate":
+            continue
         info = parse_name(name)
         key = tuple(sorted(info.items()))
-        rec = runs.setdefault(key, {"info": info, "stats": {}})
-        if b.get("run_type") == "aggregate":
-            rec["stats"][b.get("aggregate_name")] = b
-        else:
-            rec["stats"].setdefault("single", b)
+        runs.setdefault(key, {"info": info, "samples": []})["samples"].append(b)
     return data.get("context", {}), runs, errors
 
 
@@ -67,37 +89,38 @@ class Results:
         want = {k: str(v) for k, v in want.items()}
         want["family"] = family
         for rec in self.runs.values():
-            if rec["info"] == want and rec["stats"]:
+            if rec["info"] == want and rec["samples"]:
                 return rec
         return None
 
-    def value(self, family, counter, stat=None, **want):
+    def samples(self, family, counter, **want):
         rec = self.find(family, **want)
         if rec is None:
+            return []
+        return sorted(b[counter] for b in rec["samples"] if counter in b)
+
+    def value(self, family, counter, stat=None, **want):
+        v = self.samples(family, counter, **want)
+        if not v:
             return None
-        stats = rec["stats"]
-        if "single" in stats:
-            return stats["single"].get(counter)
         if stat is None:
             stat = "min" if counter in PRIMARY else "median"
-        run = stats.get(stat) or stats.get("median")
-        return None if run is None else run.get(counter)
+        if stat == "min":
+            return v[0]
+        if stat == "max":
+            return v[-1]
+        mid = len(v) // 2
+        return v[mid] if len(v) % 2 else 0.5 * (v[mid - 1] + v[mid])
 
     def spread(self, family, counter, **want):
-        """(max - min) / min over the repetitions, or None for a single run."""
-        lo = self.value(family, counter, stat="min", **want)
-        hi = self.value(family, counter, stat="max", **want)
-        rec = self.find(family, **want)
-        if rec is None or "single" in rec["stats"] or lo in (None, 0) or hi is None:
+        """(max - min) / min over the samples, or None for a single sample."""
+        v = self.samples(family, counter, **want)
+        if len(v) < 2 or v[0] == 0:
             return None
-        return (hi - lo) / lo
+        return (v[-1] - v[0]) / v[0]
 
     def repetitions(self):
-        for rec in self.runs.values():
-            for b in rec["stats"].values():
-                if b.get("run_type") == "aggregate":
-                    return b.get("repetitions")
-        return 1
+        return max((len(rec["samples"]) for rec in self.runs.values()), default=0)
 
 
 def core_share(runs):
@@ -105,11 +128,11 @@ def core_share(runs):
     share of a core they got (1.0 on an idle machine)."""
     shares = []
     for rec in runs.values():
-        b = rec["stats"].get("single") or rec["stats"].get("median")
-        if not b or rec["info"].get("threads") != "1" or "manual_time" in b.get("name", ""):
+        if rec["info"].get("threads") != "1":
             continue
-        if b.get("real_time", 0) > 0:
-            shares.append(b["cpu_time"] / b["real_time"])
+        for b in rec["samples"]:
+            if "manual_time" not in b.get("name", "") and b.get("real_time", 0) > 0:
+                shares.append(b["cpu_time"] / b["real_time"])
     if not shares:
         return None, 0
     shares.sort()
@@ -341,9 +364,9 @@ def mm_section(R):
 def unused_section(R):
     ns = "ns_per_particle"
     out = ["## 5. Unused features cost nothing", "",
-           "Same two-box geometry, supports and traction as the two-layer scene, 5 repetitions "
-           "each (minimum shown); spread = (max − min)/min over the repetitions, i.e. the noise "
-           "a difference has to beat.", ""]
+           "Same two-box geometry, supports and traction as the two-layer scene, interleaved "
+           "(minimum over the passes shown); spread = (max − min)/min over the passes, i.e. the "
+           "noise a difference has to beat.", ""]
     header = ["threads", "1 material (baseline)", "spread", "2 materials, shared field", "spread",
               "difference", "with the interface (2 fields + mm pass)"]
     rows = []
@@ -415,9 +438,15 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("json", nargs="?", default=os.path.join(here, "results.json"))
     ap.add_argument("-o", "--output", default=None, help="Markdown file (default: stdout)")
-    ap.add_argument("--load-after", default=None, help="/proc/loadavg after the run")
     ap.add_argument("--note", default=None, help="a line added under the header")
+    ap.add_argument("--merge", metavar="OUT", default=None,
+                    help="merge the pass files given as arguments into OUT and stop")
+    ap.add_argument("passes", nargs="*", help=argparse.SUPPRESS)
+    ap.add_argument("--loads", default=None, help="(with --merge) load averages per pass")
     args = ap.parse_args()
+    if args.merge:
+        merge(args.merge, [args.json] + args.passes, args.loads)
+        return
 
     context, runs, errors = load(args.json)
     R = Results(runs)
@@ -426,7 +455,7 @@ def main():
     date = context.get("date") or datetime.datetime.now().isoformat(timespec="seconds")
     load_avg = context.get("load_avg")
     lines = ["# mmpm benchmark results", "",
-             "Tables written by `bench/table.py` from `bench/results.json`; reproduce with "
+             f"Tables written by `bench/table.py` from `bench/{os.path.basename(args.json)}`; reproduce with "
              "`bench/run` (full, ~3-5 min) or `bench/run --quick` (subset, results on stdout). "
              "Only the notes at the end are hand-written.", "",
              f"- Date: {date}",
@@ -436,16 +465,18 @@ def main():
              f"- Build: Release, -O3 -march=native, MMPM_FAST_DEV={context.get('mmpm_fast_dev', '?')}; "
              f"Google Benchmark {context.get('library_version', '1.7.1')} "
              f"(Debian package, itself built as {context.get('library_build_type', '?')})",
-             f"- Load average (1/5/15 min) at start: "
-             f"{' / '.join(f'{x:.2f}' for x in load_avg) if load_avg else context.get('loadavg_before', '?')}"
-             + (f"; after the run: {args.load_after}" if args.load_after else ""),
+             f"- Load average (1/5/15 min) at the start of the first pass: "
+             f"{' / '.join(f'{x:.2f}' for x in load_avg) if load_avg else '?'}"
+             + ("; per pass (before -> after): " + "; ".join(context["pass_load_averages"])
+                if context.get("pass_load_averages") else ""),
              "- Times are wall-clock (UseRealTime, or a manual timer where state is restored "
              "between iterations). The machine has 2 cores: 2-thread numbers are only meaningful "
              "when nothing else runs (see the load average).",
-             f"- Each benchmark ran {R.repetitions()} time(s): headline times (ns/particle, "
-             "ns/node) are the minimum over the repetitions, the least disturbed run on a shared "
-             "machine; breakdown counters (stages, find/A/B) are medians, so they need not add "
-             "up exactly to the headline."]
+             f"- Each benchmark ran {R.repetitions()} time(s), once per pass of the whole set: "
+             "headline times (ns/particle, ns/node) are the minimum over the passes, the least "
+             "disturbed run on a shared machine; breakdown counters (stages, find/A/B) are "
+             "medians, so they need not add up exactly to the headline. `spread` = "
+             "(max − min)/min over the passes."]
     share, count = core_share(runs)
     if share is not None:
         lines.append(f"- CPU share: the {count} single-thread wall-clock benchmarks got a median "

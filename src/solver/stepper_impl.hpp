@@ -53,7 +53,20 @@ void Stepper<D, Shape, Real>::setup_grid() {
       G_.fi[d] = gcols_.add_real(std::string("fi") + axis[d], n);
     }
   }
-  int T = g.tile > 0 ? g.tile : (D == 2 ? 8 : 4);
+  // Tile edge (bench/RESULTS.md §1): 16 in 2D and 8 in 3D scatter fastest on
+  // this machine; smaller grids step down so every color keeps at least 8
+  // tiles for two threads. Chosen from the grid alone, never from the
+  // thread count, so the summation order (and the result) is the same for
+  // any number of threads.
+  int T = g.tile;
+  if (T <= 0) {
+    T = D == 2 ? 16 : 8;
+    for (; T > 4; T /= 2) {
+      std::size_t tiles = 1;
+      for (int d = 0; d < D; ++d) tiles *= std::size_t((g.cells[d] + T - 1) / T);
+      if (tiles >= std::size_t(8) << D) break;
+    }
+  }
   tiles_.setup(T, g.cells);
 }
 
