@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "scene/error.hpp"
+#include "solver/ramp.hpp"
 
 namespace mmpm {
 
@@ -64,8 +65,7 @@ std::vector<BoundaryNodes> resolve_boundaries(const Scene& scene) {
 Vec3 boundary_velocity(const BoundaryNodes& b, double t, double dt) {
   Vec3 v{0, 0, 0};
   if (!b.moving) return v;
-  auto frac = [&](double s) { return b.ramp > 0 ? std::min(1.0, s / b.ramp) : 1.0; };
-  const double df = frac(t + dt) - frac(t);
+  const double df = ramp_fraction(t + dt, b.ramp) - ramp_fraction(t, b.ramp);
   for (int d = 0; d < 3; ++d) v[d] = b.fix[d] ? b.displacement[d] * df / dt : 0.0;
   return v;
 }

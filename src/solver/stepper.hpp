@@ -25,6 +25,7 @@
 #include "solver/boundary.hpp"
 #include "solver/field_plan.hpp"
 #include "solver/multimaterial_stage.hpp"
+#include "solver/ramp.hpp"
 #include "solver/simulation.hpp"
 #include "solver/storage.hpp"
 

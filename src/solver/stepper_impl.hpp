@@ -377,7 +377,7 @@ void Stepper<D, Shape, Real>::update_tractions() {
     const double r = scene_.loads[l].ramp;
     // Force at mid-step, so the impulse over the ramp is exact.
     const double tm = time_ + 0.5 * dt_;
-    scale[l] = Real(r > 0 ? std::min(1.0, tm / r) : 1.0);
+    scale[l] = Real(ramp_fraction(tm, r));
   }
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (std::size_t p = 0; p < n; ++p) {
@@ -401,7 +401,7 @@ void Stepper<D, Shape, Real>::step() {
     gravity_ = {0, 0, 0};
     for (const auto& l : scene_.loads) {
       if (l.kind != LoadKind::gravity) continue;
-      const double f = l.ramp > 0 ? std::min(1.0, (time_ + 0.5 * dt_) / l.ramp) : 1.0;
+      const double f = ramp_fraction(time_ + 0.5 * dt_, l.ramp);
       for (int d = 0; d < D; ++d) gravity_[d] += f * l.acceleration[d];
     }
   }
