@@ -59,7 +59,7 @@ inline const char* real_name() {
 
 // The solver's default tile edges (solver/stepper_impl.hpp setup_grid).
 template <int D>
-inline constexpr int kDefaultTile = D == 2 ? 8 : 4;
+inline constexpr int kDefaultTile = D == 2 ? 16 : 8;
 
 // ---------------------------------------------------------------- counters
 // ns_per_particle = (time per iteration) / particles, as a rate counter: the
@@ -308,7 +308,9 @@ struct Binning {
 // ---------------------------------------------------------------- scatters
 // (a) The solver's colored scatter (Stepper::p2g): colors in turn, the tiles
 // of a color in parallel, each tile added straight into the grid.
-template <int D, class Shape, class Real, unsigned What, bool MultiField, bool Traction>
+// Windowed = false runs the pointwise reference kernel in the same tiles.
+template <int D, class Shape, class Real, unsigned What, bool MultiField, bool Traction,
+          bool Windowed = true>
 std::size_t p2g_colored(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
                         const P2GOptions& opt, const Binning<D, Real>& B) {
   std::size_t bad = SIZE_MAX;
@@ -318,7 +320,9 @@ std::size_t p2g_colored(const ParticleView<D, Real>& P, const GridView<D, Real>&
     for (std::size_t k = 0; k < nt; ++k) {
       const std::uint32_t t = tiles[k];
       const std::size_t b = B.tile_begin[t], e = B.tile_begin[t + 1];
-      const std::size_t r = p2g_range<D, Shape, Real, What, MultiField, Traction>(P, G, opt, b, e);
+      const std::size_t r =
+          Windowed ? p2g_range<D, Shape, Real, What, MultiField, Traction>(P, G, opt, b, e)
+                   : p2g_range_pointwise<D, Shape, Real, What, MultiField, Traction>(P, G, opt, b, e);
       if (r != e) bad = std::min(bad, r);
     }
   }
@@ -326,10 +330,11 @@ std::size_t p2g_colored(const ParticleView<D, Real>& P, const GridView<D, Real>&
 }
 
 // (b) Serial scatter: one thread, particle order.
-template <int D, class Shape, class Real, unsigned What>
+template <int D, class Shape, class Real, unsigned What, bool Windowed = true>
 std::size_t p2g_serial(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
                        const P2GOptions& opt) {
-  const std::size_t r = p2g_range<D, Shape, Real, What, false, false>(P, G, opt, 0, P.n);
+  const std::size_t r = Windowed ? p2g_range<D, Shape, Real, What, false, false>(P, G, opt, 0, P.n)
+                                 : p2g_range_pointwise<D, Shape, Real, What, false, false>(P, G, opt, 0, P.n);
   return r == P.n ? SIZE_MAX : r;
 }
 

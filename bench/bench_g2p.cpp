@@ -62,7 +62,9 @@ G2PFixture<D, Shape, Real>& g2p_fixture() {
   });
 }
 
-template <int D, class Shape, class Real>
+// Windowed = false: the pointwise reference gather (kernels/g2p.hpp), the
+// baseline the solver's windowed gather is compared with in the same run.
+template <int D, class Shape, class Real, bool Windowed>
 void bm_g2p(benchmark::State& state, int threads) {
   use_threads(threads);
   auto& fx = g2p_fixture<D, Shape, Real>();
@@ -81,7 +83,8 @@ void bm_g2p(benchmark::State& state, int threads) {
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
     for (std::size_t c = 0; c < chunks; ++c) {
       const std::size_t b = c * kReduceChunk, e = std::min(n, b + kReduceChunk);
-      res[c] = g2p_range<D, Shape, Real, What, false, false, false>(P, G, V, q, key_of, b, e);
+      res[c] = Windowed ? g2p_range<D, Shape, Real, What, false, false, false>(P, G, V, q, key_of, b, e)
+                        : g2p_range_pointwise<D, Shape, Real, What, false, false, false>(P, G, V, q, key_of, b, e);
     }
     keep(res.data());
     benchmark::ClobberMemory();
@@ -139,14 +142,20 @@ void bm_constitutive(benchmark::State& state, int threads) {
 
 template <int D, class Shape, class Real>
 void register_g2p_case() {
-  for (int threads : {1, 2}) {
-    const std::string name = "g2p/dim:" + std::to_string(D) + "/shape:" + Shape::name +
-                             "/real:" + real_name<Real>() + "/threads:" + std::to_string(threads);
-    auto* b = benchmark::RegisterBenchmark(name.c_str(), [threads](benchmark::State& st) {
-      bm_g2p<D, Shape, Real>(st, threads);
-    });
-    configure(b->UseRealTime()->Unit(benchmark::kMillisecond), 0.1);
-  }
+  for (const char* kernel : {"window", "pointwise"})
+    for (int threads : {1, 2}) {
+      const bool windowed = kernel[0] == 'w';
+      const std::string name = std::string(windowed ? "g2p" : "g2p_pointwise") + "/dim:" + std::to_string(D) +
+                               "/shape:" + Shape::name + "/real:" + real_name<Real>() +
+                               "/threads:" + std::to_string(threads);
+      auto* b = benchmark::RegisterBenchmark(name.c_str(), [threads, windowed](benchmark::State& st) {
+        if (windowed)
+          bm_g2p<D, Shape, Real, true>(st, threads);
+        else
+          bm_g2p<D, Shape, Real, false>(st, threads);
+      });
+      configure(b->UseRealTime()->Unit(benchmark::kMillisecond), 0.1);
+    }
 }
 
 template <int D, class Real>

@@ -83,7 +83,7 @@ MMFixture<D, Real>& mm_fixture() {
     fx->grid.setup(geo.cells, 2, true, false);
     const GridView<D, Real>& G = fx->grid.G;
     P2GOptions opt;  // displacement separation, thickness 1
-    constexpr unsigned What = kMassMomentum | kForce | kMultimaterial;
+    constexpr unsigned What = kMassMomentum | kForce | kMultimaterial | kDomainGradient;
     p2g_range<D, GimpShape, Real, What, true, false>(P, G, opt, 0, P.n);
     // As MultimaterialStage: 1e-9 of the lightest particle x 1000.
     fx->mass_threshold = Real(1e-9 * min_mass * 1000);

@@ -17,13 +17,18 @@
 namespace mmpm::bench {
 namespace {
 
-enum class Strategy { colored, serial, atomic };
+// colored / serial: the solver's windowed kernel (kernels/window.hpp);
+// colored_pointwise / serial_pointwise: the reference kernel that adds every
+// particle into its stencil node by node (the scatter before the window).
+enum class Strategy { colored, serial, atomic, colored_pointwise, serial_pointwise };
 
 const char* strategy_name(Strategy s) {
   switch (s) {
     case Strategy::colored: return "colored";
     case Strategy::serial: return "serial";
     case Strategy::atomic: return "atomic";
+    case Strategy::colored_pointwise: return "colored_pointwise";
+    case Strategy::serial_pointwise: return "serial_pointwise";
   }
   return "?";
 }
@@ -84,6 +89,12 @@ void bm_p2g(benchmark::State& state, Strategy strategy, int tile, int threads) {
       case Strategy::serial:
         bad = p2g_serial<D, Shape, Real, What>(P, G, opt);
         break;
+      case Strategy::colored_pointwise:
+        bad = p2g_colored<D, Shape, Real, What, false, false, false>(P, G, opt, fx.bins);
+        break;
+      case Strategy::serial_pointwise:
+        bad = p2g_serial<D, Shape, Real, What, false>(P, G, opt);
+        break;
       case Strategy::atomic:
         bad = p2g_atomic<D, Shape, Real>(P, G);
         break;
@@ -120,7 +131,7 @@ void register_case() {
                            "/real:" + real_name<Real>() + "/strategy:";
   auto add = [&](Strategy s, int tile, int threads) {
     std::string name = base + strategy_name(s);
-    if (s == Strategy::colored) name += "/tile:" + std::to_string(tile);
+    if (s == Strategy::colored || s == Strategy::colored_pointwise) name += "/tile:" + std::to_string(tile);
     name += "/threads:" + std::to_string(threads);
     auto* b = benchmark::RegisterBenchmark(name.c_str(), [s, tile, threads](benchmark::State& st) {
       bm_p2g<D, Shape, Real>(st, s, tile, threads);
@@ -133,6 +144,9 @@ void register_case() {
   add(Strategy::atomic, T, 2);
   add(Strategy::colored, T, 1);
   add(Strategy::colored, T, 2);
+  add(Strategy::serial_pointwise, T, 1);
+  add(Strategy::colored_pointwise, T, 1);
+  add(Strategy::colored_pointwise, T, 2);
 }
 
 // Tile edge sweep of the colored scatter (the solver's default is 8 in 2D, 4 in

@@ -2,11 +2,10 @@
 // races"). Cells are grouped into square tiles of T cells per direction;
 // a particle's key is its tile index times T^D plus its cell inside the
 // tile, so a stable counting sort by key groups particles tile by tile (and
-// cell by cell inside a tile, for locality). Tiles whose indices have the
-// same parity in every direction share a color; two tiles of one color are
-// at least T cells apart, and a particle in cell c touches nodes c-1 .. c+2
-// at most (every shape function here), so T >= 3 keeps same-colored tiles
-// on disjoint nodes.
+// cell by cell inside a tile, for locality and for the windowed scatter). Tiles whose indices have
+// the same parity in every direction share a color; two tiles of one color are at least T cells
+// apart, and a particle in cell c touches nodes c-1 .. c+2 at most (every shape function here), so
+// T >= 3 keeps same-colored tiles on disjoint nodes.
 #pragma once
 
 #include <array>
@@ -21,8 +20,8 @@ namespace mmpm {
 
 template <int D>
 struct TileLayout {
-  int T = 8;                        // tile edge in cells: a power of two (shifts, not divisions)
-  int shift = 3;                    // log2(T)
+  int T = 8;      // tile edge in cells: a power of two (shifts, not divisions)
+  int shift = 3;  // log2(T)
   std::array<int, 3> cells{1, 1, 1};
   std::array<int, 3> tiles{1, 1, 1};
   std::uint32_t keys_per_tile = 1;  // T^D
@@ -47,12 +46,19 @@ struct TileLayout {
 
   // Key of a cell given by its integer indices (clamped into the grid so that
   // a particle exactly on the upper boundary still gets a valid key).
+  // Inside a tile, cells go y fastest, then z, x slowest: consecutive cells
+  // differ by one in y, so the windowed scatter's consecutive blocks
+  // (kernels/window.hpp) meet on whole rows along x at the same addresses,
+  // and each row load is served by the previous block's row store. In x
+  // order they would overlap by all but one node, a partial overlap the
+  // CPU cannot forward (the load waits for the store to reach the cache).
   std::uint32_t key(const std::array<int, 3>& c_in) const {
     std::uint32_t tile = 0, local = 0, tstride = 1;
     for (int d = 0; d < D; ++d) {
       const int c = c_in[d] < 0 ? 0 : (c_in[d] >= cells[d] ? cells[d] - 1 : c_in[d]);
       tile += std::uint32_t(c >> shift) * tstride;
-      local |= std::uint32_t(c & (T - 1)) << (d * shift);
+      const int slot = d == 0 ? D - 1 : d - 1;  // x -> highest bits
+      local |= std::uint32_t(c & (T - 1)) << (slot * shift);
       tstride *= std::uint32_t(tiles[d]);
     }
     return (tile << key_shift) | local;

@@ -6,15 +6,23 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <type_traits>
 
 #include "kernels/grid_update.hpp"
 #include "kernels/weights.hpp"
+#include "kernels/window_block.hpp"
 
 namespace mmpm {
 
 enum G2PWhat : unsigned {
-  kUpdateMotion = 1u,    // v and x
-  kVelocityGradient = 2u // L = sum v_i (x) G_ip
+  kUpdateMotion = 1u,      // v and x (x_next under MUSL)
+  kVelocityGradient = 2u,  // L = sum v_i (x) G_ip
+  // MUSL's fused passes (Stepper::step): the new particle momentum m v goes
+  // straight back to the grid momentum with the same weights (the second
+  // transfer), so the caller must run tiles color by color like P2G; and
+  // the velocity-gradient pass moves x to x_next when it is done with x.
+  kScatterMomentum = 4u,
+  kCommitPosition = 8u,
 };
 
 struct G2PParams {
@@ -33,22 +41,135 @@ struct G2PRangeResult {
   bool moved_tile = false;
 };
 
+// Gathers the grid velocity, velocity change and velocity gradient of one
+// particle. Windowed: rows of W nodes along x, with the separable sums
+//   v_p = sum_x wx * A,  L_d,x = sum_x gx * A,  L_d,y = sum_x wx * B, ...
+// where A = sum over the rows of (wy wz) v_row, B = sum of (gy wz) v_row,
+// C = sum of (wy gz) v_row: three vector multiply-adds per row and field
+// instead of one scalar pass per node. Pointwise: node by node on the stencil.
+template <int D, class Shape, class Real, bool Windowed>
+struct G2PGather {
+  using Win = Window<D, Shape, Real>;
+  using St = Stencil<D, Shape, Real>;
+  std::conditional_t<Windowed, Win, St> w;
+  const GridView<D, Real>& grid_;
+  std::array<Real, 3> inv_h_;
+  typename Win::Offsets offsets{};
+
+  explicit G2PGather(const GridView<D, Real>& grid)
+      : w(make(grid)),
+        grid_(grid),
+        inv_h_{Real(1) / grid.h[0], Real(1) / grid.h[1], Real(1) / grid.h[2]} {
+    if constexpr (Windowed) offsets = Win::offsets(grid);
+  }
+  static auto make(const GridView<D, Real>& grid) {
+    if constexpr (Windowed)
+      return Win(grid);
+    else
+      return St{};
+  }
+
+  bool build(const ParticleView<D, Real>& P, std::size_t p) {
+    if constexpr (Windowed)
+      return w.build(P, p);
+    else
+      return w.build(P, grid_, inv_h_, p);
+  }
+
+  // vn, dv: velocity and its change over the step; L row-major dv_a/dx_b.
+  template <bool Motion, bool Gradient>
+  void gather(const GridVelocity<D, Real>& V, std::size_t field_offset, Real* vn, Real* dv,
+              Real* L) const {
+    const std::size_t b = w.base + field_offset;
+    if constexpr (!Windowed) {
+      for (int k = 0; k < St::count; ++k) {
+        const std::size_t i = b + w.node[k];
+        const Real s = w.w[k];
+        for (int d = 0; d < D; ++d) {
+          const Real vi = V.vel[d][i];
+          if constexpr (Motion) {
+            vn[d] += s * vi;
+            dv[d] += s * V.dvel[d][i];
+          }
+          if constexpr (Gradient)
+            for (int e = 0; e < D; ++e) L[d * D + e] += vi * w.g[k][e];
+        }
+      }
+    } else {
+      // Unit sums A = sum_u Y(u) v_u, B = sum_u GY(u) v_u, C = sum_u GZ(u) v_u,
+      // then v_p = sum(X A), L_d,x = sum(GX A), L_d,y = sum(X B), L_d,z = sum(X C).
+      using Vec = typename Win::V;
+      constexpr int Ln = Win::L;
+      const auto& off = offsets;
+      for (int d = 0; d < D; ++d) {
+        Vec A{}, B{}, C{}, Q{};
+        const Real* vel = V.vel[d] + b;
+        const Real* dvel = V.dvel[d] + b;
+        for (int u = 0; u < Win::units; ++u) {
+          const Vec vu = Win::load(vel, off, u);
+          A += w.Y(u) * vu;
+          if constexpr (Gradient) {
+            B += w.GY(u) * vu;
+            if constexpr (D == 3) C += w.GZ(u) * vu;
+          }
+          if constexpr (Motion) Q += w.Y(u) * Win::load(dvel, off, u);
+        }
+        const Vec X = w.X();
+        if constexpr (Motion) {
+          vn[d] = lanes_sum<Real, Ln>(X * A);
+          dv[d] = lanes_sum<Real, Ln>(X * Q);
+        }
+        if constexpr (Gradient) {
+          L[d * D + 0] = lanes_sum<Real, Ln>(w.GX() * A);
+          L[d * D + 1] = lanes_sum<Real, Ln>(X * B);
+          if constexpr (D == 3) L[d * D + 2] = lanes_sum<Real, Ln>(X * C);
+        }
+      }
+    }
+  }
+};
+
 template <int D, class Shape, class Real, unsigned What, bool MultiField, bool Traction,
-          bool Gravity, class KeyFn>
-G2PRangeResult g2p_range(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
-                         const GridVelocity<D, Real>& V, const G2PParams& q,
-                         const KeyFn& key_of, std::size_t begin, std::size_t end) {
+          bool Gravity, bool Windowed, class KeyFn>
+G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const GridView<D, Real>& grid,
+                              const GridVelocity<D, Real>& velocities, const G2PParams& q,
+                              const KeyFn& key_of, std::size_t begin, std::size_t end) {
+  // Local copies of the views: the particle stores below cannot alias them,
+  // so the array pointers stay in registers.
+  const ParticleView<D, Real> P = particles;
+  const GridView<D, Real> G = grid;
+  const GridVelocity<D, Real> V = velocities;
   G2PRangeResult r;
-  const std::array<Real, 3> inv_h{Real(1) / G.h[0], Real(1) / G.h[1], Real(1) / G.h[2]};
   const Real dt = Real(q.dt), flip = Real(q.flip), pic = Real(1) - Real(q.flip);
-  Stencil<D, Shape, Real> st;
+  G2PGather<D, Shape, Real, Windowed> st(G);
+  constexpr bool kScatter = (What & kScatterMomentum) != 0;
+  static_assert(!kScatter || (What & kUpdateMotion) != 0,
+                "the momentum scattered is the updated one");
+  // The second transfer's block (windowed), or node-by-node adds (pointwise).
+  using Block = WindowBlock<D, Shape, Real, kMomentumOnly, false>;
+  Block block;
+  const auto off =
+      Windowed ? Window<D, Shape, Real>::offsets(G) : typename Window<D, Shape, Real>::Offsets{};
+  auto scatter_momentum = [&](std::size_t p, std::size_t fo) {
+    ScatterSource<D, Real> s;
+    for (int d = 0; d < D; ++d) s.mv[d] = P.m[p] * P.v[d][p];
+    if constexpr (Windowed) {
+      block.at(st.w.base + fo, G, off);
+      block.accumulate(st.w, s);
+    } else {
+      for (int k = 0; k < st.w.count; ++k) {
+        const std::size_t i = st.w.base + fo + st.w.node[k];
+        for (int d = 0; d < D; ++d) G.p[d][i] += st.w.w[k] * s.mv[d];
+      }
+    }
+  };
   for (std::size_t p = begin; p < end; ++p) {
-    if (!st.build(P, G, inv_h, p)) {
+    if (!st.build(P, p)) {
       if (r.bad == SIZE_MAX) r.bad = p;
       continue;
     }
     const int field = MultiField ? int(P.field[p]) : 0;
-    const std::size_t b = st.base + (MultiField ? std::size_t(field) * G.nodes : 0);
+    const std::size_t fo = MultiField ? std::size_t(field) * G.nodes : 0;
     if constexpr ((What & kUpdateMotion) != 0) {
       if (MultiField && q.rigid && q.rigid[field]) {  // prescribed motion (§7)
         for (int d = 0; d < D; ++d) {
@@ -59,23 +180,13 @@ G2PRangeResult g2p_range(const ParticleView<D, Real>& P, const GridView<D, Real>
             P.x[d][p] += dt * P.v[d][p];
         }
         if (!P.x_next[0] && key_of.tile(p) != key_of.tile_of_key(P.key[p])) r.moved_tile = true;
+        if constexpr (kScatter) scatter_momentum(p, fo);
         continue;
       }
     }
     Real vn[D] = {}, dv[D] = {}, L[D * D] = {};
-    for (int k = 0; k < st.count; ++k) {
-      const std::size_t i = b + st.node[k];
-      const Real w = st.w[k];
-      for (int d = 0; d < D; ++d) {
-        const Real vi = V.vel[d][i];
-        if constexpr ((What & kUpdateMotion) != 0) {
-          vn[d] += w * vi;
-          dv[d] += w * V.dvel[d][i];
-        }
-        if constexpr ((What & kVelocityGradient) != 0)
-          for (int e = 0; e < D; ++e) L[d * D + e] += vi * st.g[k][e];
-      }
-    }
+    st.template gather<(What & kUpdateMotion) != 0, (What & kVelocityGradient) != 0>(V, fo, vn, dv,
+                                                                                     L);
     if constexpr ((What & kUpdateMotion) != 0) {
       bool finite = true;
       double work = 0;
@@ -96,11 +207,42 @@ G2PRangeResult g2p_range(const ParticleView<D, Real>& P, const GridView<D, Real>
       if constexpr (Traction || Gravity) r.external_work += work * q.dt;
       if (!finite && r.bad == SIZE_MAX) r.bad = p;
       if (!P.x_next[0] && key_of.tile(p) != key_of.tile_of_key(P.key[p])) r.moved_tile = true;
+      if constexpr (kScatter) scatter_momentum(p, fo);
     }
     if constexpr ((What & kVelocityGradient) != 0)
       for (int c = 0; c < D * D; ++c) P.L[c][p] = L[c];
+    if constexpr ((What & kCommitPosition) != 0) {
+      for (int d = 0; d < D; ++d) P.x[d][p] = P.x_next[d][p];
+      if (key_of.tile(p) != key_of.tile_of_key(P.key[p])) r.moved_tile = true;
+    }
   }
+  if constexpr (kScatter && Windowed) block.flush(G, off);
   return r;
+}
+
+// The solver's G2P: windowed for the 4-node windows; pointwise for linear
+// shapes (bench: the 2-node gather is faster node by node than through
+// the flat window's horizontal sums) and for grids too small for a window.
+template <int D, class Shape, class Real, unsigned What, bool MultiField, bool Traction,
+          bool Gravity, class KeyFn>
+G2PRangeResult g2p_range(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
+                         const GridVelocity<D, Real>& V, const G2PParams& q, const KeyFn& key_of,
+                         std::size_t begin, std::size_t end) {
+  if (!Window<D, Shape, Real>::flat && Window<D, Shape, Real>::fits(G))
+    return g2p_range_impl<D, Shape, Real, What, MultiField, Traction, Gravity, true>(
+        P, G, V, q, key_of, begin, end);
+  return g2p_range_impl<D, Shape, Real, What, MultiField, Traction, Gravity, false>(
+      P, G, V, q, key_of, begin, end);
+}
+
+// The reference gather, node by node (benchmark baseline).
+template <int D, class Shape, class Real, unsigned What, bool MultiField, bool Traction,
+          bool Gravity, class KeyFn>
+G2PRangeResult g2p_range_pointwise(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
+                                   const GridVelocity<D, Real>& V, const G2PParams& q,
+                                   const KeyFn& key_of, std::size_t begin, std::size_t end) {
+  return g2p_range_impl<D, Shape, Real, What, MultiField, Traction, Gravity, false>(
+      P, G, V, q, key_of, begin, end);
 }
 
 }  // namespace mmpm

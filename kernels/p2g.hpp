@@ -7,27 +7,18 @@
 #include <cstdint>
 
 #include "kernels/weights.hpp"
+#include "kernels/window_block.hpp"
 
 namespace mmpm {
 
-// What a P2G pass scatters (bit mask).
-enum P2GWhat : unsigned {
-  kMassMomentum = 1u,  // m, p
-  kForce = 2u,         // internal force -V sigma.G, traction force S fext
-  kMultimaterial = 4u, // mx, Omega, g  (ALGORITHM §1, P-10/13, P-19, P-33)
-  kMomentumOnly = 8u,  // p alone (MUSL's second transfer)
-};
-
-struct P2GOptions {
-  bool position_separation = false;  // mx holds positions (else displacements)
-  double inv_thickness = 1.0;        // 2D: Omega and g are areas (P-19, P-33)
-};
-
-// Scatters particles [begin, end). Returns the first particle whose stencil
-// leaves the grid, or end.
+// The reference scatter: every particle adds into its stencil's nodes one
+// by one. Kept as the baseline the benchmarks compare the windowed scatter
+// with, and for grids too small to hold a window. Scatters particles
+// [begin, end); returns the first particle whose stencil leaves the grid, or
+// end.
 template <int D, class Shape, class Real, unsigned What, bool MultiField, bool Traction>
-std::size_t p2g_range(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
-                      const P2GOptions& opt, std::size_t begin, std::size_t end) {
+std::size_t p2g_range_pointwise(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
+                                const P2GOptions& opt, std::size_t begin, std::size_t end) {
   constexpr int NS = kStressComponents<D>;
   const std::array<Real, 3> inv_h{Real(1) / G.h[0], Real(1) / G.h[1], Real(1) / G.h[2]};
   const Real inv_t = Real(opt.inv_thickness);
@@ -77,13 +68,59 @@ std::size_t p2g_range(const ParticleView<D, Real>& P, const GridView<D, Real>& G
       }
       if constexpr ((What & kMultimaterial) != 0) {
         G.vol[i] += w * area;
-        for (int d = 0; d < D; ++d) {
-          G.mx[d][i] += w * mw[d];
-          G.g[d][i] += st.g[k][d] * area;
-        }
+        for (int d = 0; d < D; ++d) G.mx[d][i] += w * mw[d];
+        if constexpr ((What & kDomainGradient) != 0)
+          for (int d = 0; d < D; ++d) G.g[d][i] += st.g[k][d] * area;
       }
     }
   }
+  return end;
+}
+
+// The solver's scatter (kernels/window.hpp explains the window): particles
+// of one window (consecutive in the binning order: same cell and field) add
+// into a local block, which goes to the grid when the window changes. Same
+// sums as p2g_range_pointwise, in a different order (round-off level).
+// Scatters particles [begin, end); returns the first particle whose stencil
+// leaves the grid, or end.
+template <int D, class Shape, class Real, unsigned What, bool MultiField, bool Traction>
+std::size_t p2g_range(const ParticleView<D, Real>& particles, const GridView<D, Real>& grid,
+                      const P2GOptions& opt, std::size_t begin, std::size_t end) {
+  // Local copies of the views: the grid stores below cannot alias them, so
+  // the array pointers stay in registers.
+  const ParticleView<D, Real> P = particles;
+  const GridView<D, Real> G = grid;
+  using Win = Window<D, Shape, Real>;
+  if (!Win::fits(G))
+    return p2g_range_pointwise<D, Shape, Real, What, MultiField, Traction>(P, G, opt, begin, end);
+  constexpr int NS = kStressComponents<D>;
+  using Block = WindowBlock<D, Shape, Real, What, Traction>;
+  const Real inv_t = Real(opt.inv_thickness);
+  const auto off = Win::offsets(G);
+  Block block;
+  Win win(G);
+  for (std::size_t p = begin; p < end; ++p) {
+    if (!win.build(P, p)) {
+      block.flush(G, off);
+      return p;
+    }
+    block.at(win.base + (MultiField ? std::size_t(P.field[p]) * G.nodes : 0), G, off);
+    ScatterSource<D, Real> q;
+    q.m = P.m[p];
+    for (int d = 0; d < D; ++d) q.mv[d] = q.m * P.v[d][p];
+    if constexpr (Block::kFrc) {
+      for (int c = 0; c < NS; ++c) q.vs[c] = P.V[p] * P.s[c][p];
+      if constexpr (Traction)
+        for (int d = 0; d < D; ++d) q.fe[d] = P.fext[d][p];
+    }
+    if constexpr (Block::kMM) {
+      q.area = P.V[p] * (D == 2 ? inv_t : Real(1));
+      for (int d = 0; d < D; ++d)
+        q.mw[d] = q.m * (opt.position_separation ? P.x[d][p] : P.x[d][p] - P.x0[d][p]);
+    }
+    block.accumulate(win, q);
+  }
+  block.flush(G, off);
   return end;
 }
 

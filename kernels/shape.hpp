@@ -1,16 +1,25 @@
 // Shape functions in one dimension; the D-dimensional weight is the tensor
 // product (ALGORITHM §1 uses S_ip and G_ip). Coordinates are in cell units:
-// xi = (x - origin) / h. Every function fills the S weights of the nodes
-// base .. base + S - 1 and their derivatives d/dxi (the caller divides by h).
+// xi = (x - origin) / h. Two forms:
+//  - eval(): the S weights of the nodes base .. base + S - 1 and their
+//    derivatives d/dxi (the caller divides by h); the pointwise kernels.
+//  - lanes(): weight and derivative of one node at distance d = xi - node,
+//    elementwise on a vector of distances (kernels/lanes.hpp), zero beyond
+//    the function's reach; the window kernels (kernels/window.hpp) evaluate
+//    all window nodes of all directions in one call.
 #pragma once
 
 #include <cmath>
+
+#include "kernels/lanes.hpp"
 
 namespace mmpm {
 
 // Linear hat functions: two nodes per direction.
 struct LinearShape {
   static constexpr int S = 2;
+  static constexpr int W = 2;          // window nodes per direction (kernels/window.hpp)
+  static constexpr int window_lo = 0;  // window starts at cell - window_lo
   static constexpr const char* name = "linear";
   template <class Real>
   static int eval(Real xi, Real /*half_width*/, Real* w, Real* dw) {
@@ -21,6 +30,13 @@ struct LinearShape {
     dw[0] = Real(-1);
     dw[1] = Real(1);
     return int(fb);
+  }
+  // hat(d) = 1 - |d|; a window node is never farther than one cell.
+  template <class V>
+  static void lanes(const V& d, const V& /*half_width*/, V& w, V& dw) {
+    using R = LaneReal<V>;
+    w = R(1) - lanes_abs(d);
+    dw = d < R(0) ? R(1) + V{} : R(-1) + V{};
   }
 };
 
@@ -34,6 +50,11 @@ struct LinearShape {
 // stencil evaluation does not mispredict as particles move.
 struct GimpShape {
   static constexpr int S = 3;
+  // The window covers every stencil of a particle in one cell: nodes
+  // cell-1 .. cell+2. node() is zero beyond the particle's reach, so the
+  // window weights need no padding logic.
+  static constexpr int W = 4;
+  static constexpr int window_lo = 1;
   static constexpr const char* name = "gimp";
   template <class Real>
   static Real clamp1(Real s) {
@@ -55,11 +76,24 @@ struct GimpShape {
     for (int k = 0; k < 3; ++k) node(r - Real(k), l, w[k], dw[k]);
     return int(fb);
   }
+  // node() lane by lane.
+  template <class V>
+  static void lanes(const V& d, const V& l, V& w, V& dw) {
+    using R = LaneReal<V>;
+    const V one = 1 + V{}, minus_one = -1 + V{};
+    const V inv2l = R(0.5) / l;
+    const V a = lanes_clamp(d + l, minus_one, one), b = lanes_clamp(d - l, minus_one, one);
+    const V aa = lanes_abs(a), ab = lanes_abs(b);
+    w = ((a - R(0.5) * a * aa) - (b - R(0.5) * b * ab)) * inv2l;
+    dw = (ab - aa) * inv2l;
+  }
 };
 
 // Quadratic B-spline: three nodes.
 struct BSpline2Shape {
   static constexpr int S = 3;
+  static constexpr int W = 4;  // as uGIMP: nodes cell-1 .. cell+2
+  static constexpr int window_lo = 1;
   static constexpr const char* name = "bspline2";
   template <class Real>
   static int eval(Real xi, Real /*half_width*/, Real* w, Real* dw) {
@@ -74,6 +108,17 @@ struct BSpline2Shape {
     dw[2] = c;
     return int(fb);
   }
+  // N(d) = 3/4 - d^2 for |d| < 1/2, (3/2 - |d|)^2 / 2 for |d| < 3/2, else 0;
+  // written with selects so the four window nodes vectorise.
+  template <class V>
+  static void lanes(const V& d, const V& /*half_width*/, V& w, V& dw) {
+    using R = LaneReal<V>;
+    const V a = lanes_abs(d);
+    const V t = lanes_max(R(1.5) - a, V{});
+    const auto inner = a < R(0.5);
+    w = inner ? R(0.75) - d * d : R(0.5) * t * t;
+    dw = inner ? R(-2) * d : (d < R(0) ? t : -t);
+  }
 };
 
 // Cubic B-spline: four nodes. With r = xi - base in [1, 2) the distances
@@ -82,15 +127,33 @@ struct BSpline2Shape {
 // weights need no branches.
 struct BSpline3Shape {
   static constexpr int S = 4;
+  static constexpr int W = 4;  // the stencil itself: nodes cell-1 .. cell+2
+  static constexpr int window_lo = 1;
   static constexpr const char* name = "bspline3";
   template <class Real>
   static int eval(Real xi, Real /*half_width*/, Real* w, Real* dw) {
     const Real fb = std::floor(xi) - Real(1);
-    const Real r = xi - fb;                   // in [1, 2)
-    const Real q0 = Real(2) - r;              // outer piece, d = r
-    const Real a1 = r - Real(1);              // inner piece, d = r - 1 >= 0
-    const Real a2 = Real(2) - r;              // inner piece, d = r - 2 < 0, |d| = 2 - r
-    const Real q3 = r - Real(1);              // outer piece, d = r - 3, 2 - |d| = r - 1
+    weights(xi - fb, w, dw);
+    return int(fb);
+  }
+  // N(d) = 2/3 - d^2 + |d|^3/2 for |d| < 1, (2 - |d|)^3/6 for |d| < 2.
+  template <class V>
+  static void lanes(const V& d, const V& /*half_width*/, V& w, V& dw) {
+    using R = LaneReal<V>;
+    const V a = lanes_abs(d);
+    const V t = lanes_max(R(2) - a, V{});
+    const auto inner = a < R(1);
+    const auto neg = d < R(0);
+    w = inner ? R(2) / R(3) - d * d + R(0.5) * a * a * a : t * t * t * (R(1) / R(6));
+    const V douter = R(0.5) * t * t;
+    dw = inner ? R(-2) * d + R(1.5) * d * a : (neg ? douter : -douter);
+  }
+  template <class Real>
+  static void weights(Real r, Real* w, Real* dw) {  // r in [1, 2)
+    const Real q0 = Real(2) - r;                    // outer piece, d = r
+    const Real a1 = r - Real(1);                    // inner piece, d = r - 1 >= 0
+    const Real a2 = Real(2) - r;                    // inner piece, d = r - 2 < 0, |d| = 2 - r
+    const Real q3 = r - Real(1);                    // outer piece, d = r - 3, 2 - |d| = r - 1
     w[0] = q0 * q0 * q0 / Real(6);
     dw[0] = Real(-0.5) * q0 * q0;
     w[1] = Real(2) / Real(3) - a1 * a1 + Real(0.5) * a1 * a1 * a1;
@@ -99,7 +162,6 @@ struct BSpline3Shape {
     dw[2] = Real(2) * a2 - Real(1.5) * a2 * a2;
     w[3] = q3 * q3 * q3 / Real(6);
     dw[3] = Real(0.5) * q3 * q3;
-    return int(fb);
   }
 };
 

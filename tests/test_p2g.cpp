@@ -23,6 +23,12 @@
 //    only needs the fixed color order, which is what is checked bitwise.)
 //  - Tiles of one color never touch a common node (checked node by node, so
 //    a coloring bug fails deterministically rather than by a lucky race).
+//  - The windowed kernels (kernels/window.hpp: p2g_range, g2p_range) equal
+//    the pointwise reference kernels (p2g_range_pointwise,
+//    g2p_range_pointwise) to 1e-12 (double) / 2e-5 (float) relative to each
+//    array's largest magnitude, with particles spread over the grid and with
+//    half of them within 1.5 cells of an edge (where the window is shifted
+//    inward), in tile order and in random order.
 // Resolution: 2D grid 37 x 29 cells, 6000 particles; 3D 13 x 12 x 11 cells,
 // 4000 particles; cells of unequal size; tile edges 4 (the minimum: TileLayout
 // rounds the edge up to a power of two >= 4), 8 and 16.
@@ -40,6 +46,7 @@
 #include <vector>
 
 #include "kernels/binning.hpp"
+#include "kernels/g2p.hpp"
 #include "kernels/grid_view.hpp"
 #include "kernels/p2g.hpp"
 #include "kernels/particle_view.hpp"
@@ -57,7 +64,7 @@ struct Cfg {
   using Real = R;
 };
 
-constexpr unsigned kAll = kMassMomentum | kForce | kMultimaterial;
+constexpr unsigned kAll = kMassMomentum | kForce | kMultimaterial | kDomainGradient;
 
 // Owning particle arrays (SoA) and their view.
 template <int D, class Real>
@@ -458,6 +465,163 @@ TYPED_TEST(P2G, ColoredScatterMatchesSerialSingleFieldTile8) {
 }
 TYPED_TEST(P2G, ColoredScatterMatchesSerialMultiFieldNoTraction) {
   check_colored<TypeParam::D, typename TypeParam::Shape, typename TypeParam::Real, true, false>(TypeParam::D == 2 ? 8 : 4, 303);
+}
+
+// Particles over the whole range a shape allows (window.hpp: linear
+// [0, n-1), uGIMP/quadratic [1/2, n-3/2), cubic [1, n-2) in cell units),
+// every second one within 1.5 cells of the low or high edge in a random
+// direction.
+template <int D, class Shape, class Real>
+void spread_to_edges(Particles<D, Real>& p, const GridView<D, Real>& G, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  const double lo = Shape::W == 2 ? 0.0 : (Shape::S == 3 ? 0.5 : 1.0);
+  const double margin = Shape::W == 2 ? 1.0 : (Shape::S == 3 ? 1.5 : 2.0);
+  for (std::size_t i = 0; i < p.n; ++i) {
+    const int edge_dim = int(U(rng) * D);
+    for (int d = 0; d < D; ++d) {
+      const double hi = double(G.nodes_per_dim[d]) - margin;
+      double xi = lo + (hi - lo) * U(rng);
+      if (i % 2 == 0 && d == edge_dim) xi = U(rng) < 0.5 ? lo + 1.5 * U(rng) : hi - 1.5 * U(rng);
+      xi = std::min(std::max(xi, lo), std::nextafter(hi, lo) - 1e-6);
+      p.x[d][i] = Real(double(G.origin[d]) + xi * double(G.h[d]));
+      // Keep the Real position inside the range after rounding.
+      const double back = (double(p.x[d][i]) - double(G.origin[d])) / double(G.h[d]);
+      if (back < lo || back >= hi) p.x[d][i] = Real(double(G.origin[d]) + (lo + hi) * 0.5 * double(G.h[d]));
+    }
+  }
+}
+
+template <class Real>
+double max_rel_diff(const std::vector<Real>& a, const std::vector<Real>& b, double& scale) {
+  double diff = 0;
+  scale = 0;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    scale = std::max(scale, std::abs(double(b[k])));
+    diff = std::max(diff, std::abs(double(a[k]) - double(b[k])));
+  }
+  return scale > 0 ? diff / scale : diff;
+}
+
+template <int D, class Shape, class Real>
+void check_window_p2g(bool edges, bool sorted, unsigned seed) {
+  const bool gimp = std::string(Shape::name) == "gimp";
+  Grid<D, Real> win(grid_cells<D>(), 2), ref(grid_cells<D>(), 2);
+  const std::size_t n = D == 2 ? 6000 : 4000;
+  auto p = random_particles<D, Real>(win.G, win.cells, n, seed);
+  if (edges) spread_to_edges<D, Shape, Real>(p, win.G, seed + 1);
+  if (sorted) {
+    TileLayout<D> tiles;
+    tiles.setup(4, win.cells);
+    p = p.permuted(sort_by_tile(p, win.G, tiles));
+  }
+  const auto P = p.view(gimp);
+  P2GOptions opt;
+  opt.inv_thickness = 0.5;
+  ASSERT_EQ((p2g_range<D, Shape, Real, kAll, true, true>(P, win.G, opt, 0, n)), n);
+  ASSERT_EQ((p2g_range_pointwise<D, Shape, Real, kAll, true, true>(P, ref.G, opt, 0, n)), n);
+  const double tol = conservation_tol<Real>();
+  for (std::size_t a = 0; a < win.arrays.size(); ++a) {
+    double scale = 0;
+    const double rel = max_rel_diff(win.arrays[a], ref.arrays[a], scale);
+    EXPECT_GT(scale, 0.0) << "array " << a << " was filled";
+    EXPECT_LE(rel, tol) << "array " << a << ": windowed vs pointwise scatter";
+  }
+  // The momentum-only transfer (MUSL's second P2G) on its own.
+  Grid<D, Real> win2(grid_cells<D>(), 2), ref2(grid_cells<D>(), 2);
+  ASSERT_EQ((p2g_range<D, Shape, Real, kMomentumOnly, true, false>(P, win2.G, opt, 0, n)), n);
+  ASSERT_EQ((p2g_range_pointwise<D, Shape, Real, kMomentumOnly, true, false>(P, ref2.G, opt, 0, n)), n);
+  for (int d = 0; d < D; ++d) {
+    double scale = 0;
+    EXPECT_LE(max_rel_diff(win2.arrays[std::size_t(1 + d)], ref2.arrays[std::size_t(1 + d)], scale), tol)
+        << "momentum " << d;
+    EXPECT_EQ(win2.sum(win2.G.m), 0.0) << "momentum-only transfer left the mass alone";
+  }
+}
+
+TYPED_TEST(P2G, WindowedScatterMatchesPointwise) {
+  check_window_p2g<TypeParam::D, typename TypeParam::Shape, typename TypeParam::Real>(false, true, 401);
+}
+TYPED_TEST(P2G, WindowedScatterMatchesPointwiseAtGridEdgesUnsorted) {
+  check_window_p2g<TypeParam::D, typename TypeParam::Shape, typename TypeParam::Real>(true, false, 402);
+}
+
+// A particle whose stencil leaves the grid is reported by both kernels at
+// the same index.
+TYPED_TEST(P2G, WindowedScatterReportsTheSameParticleOffTheGrid) {
+  constexpr int D = TypeParam::D;
+  using Shape = typename TypeParam::Shape;
+  using Real = typename TypeParam::Real;
+  Grid<D, Real> a(grid_cells<D>(), 1), b(grid_cells<D>(), 1);
+  auto p = random_particles<D, Real>(a.G, a.cells, 200, 403);
+  std::fill(p.field.begin(), p.field.end(), std::uint8_t(0));
+  p.x[0][117] = a.G.origin[0] + Real(0.2) * a.G.h[0];  // too close to the low x edge for any shape but linear
+  if (Shape::W == 2) p.x[0][117] = a.G.origin[0] - Real(0.2) * a.G.h[0];
+  const auto P = p.view(std::string(Shape::name) == "gimp");
+  EXPECT_EQ((p2g_range<D, Shape, Real, kMassMomentum, false, false>(P, a.G, P2GOptions{}, 0, 200)), 117u);
+  EXPECT_EQ((p2g_range_pointwise<D, Shape, Real, kMassMomentum, false, false>(P, b.G, P2GOptions{}, 0, 200)), 117u);
+}
+
+// G2P: the solver's windowed gather against the pointwise reference, on a
+// smooth random grid velocity field, all outputs (v, x, L).
+struct NoKeys {
+  std::uint32_t tile(std::size_t) const { return 0; }
+  std::uint32_t tile_of_key(std::uint32_t) const { return 0; }
+};
+
+template <int D, class Shape, class Real>
+void check_window_g2p(bool edges, unsigned seed) {
+  const bool gimp = std::string(Shape::name) == "gimp";
+  Grid<D, Real> g(grid_cells<D>(), 2);
+  const std::size_t total = g.G.nodes * 2;
+  std::vector<std::vector<Real>> vel(D, std::vector<Real>(total)), dvel(D, std::vector<Real>(total));
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  GridVelocity<D, Real> V;
+  for (int d = 0; d < D; ++d) {
+    for (std::size_t i = 0; i < total; ++i) vel[d][i] = Real(U(rng)), dvel[d][i] = Real(0.1 * U(rng));
+    V.vel[d] = vel[d].data();
+    V.dvel[d] = dvel[d].data();
+  }
+  const std::size_t n = D == 2 ? 6000 : 4000;
+  auto base = random_particles<D, Real>(g.G, g.cells, n, seed);
+  if (edges) spread_to_edges<D, Shape, Real>(base, g.G, seed + 1);
+  auto a = base, b = base;
+  std::array<std::vector<Real>, D * D> La, Lb;
+  for (auto& l : La) l.assign(n, 0);
+  for (auto& l : Lb) l.assign(n, 0);
+  auto Pa = a.view(gimp), Pb = b.view(gimp);
+  for (int c = 0; c < D * D; ++c) Pa.L[c] = La[c].data(), Pb.L[c] = Lb[c].data();
+  G2PParams q;
+  q.dt = 0.01;
+  q.flip = 0.9;
+  constexpr unsigned What = kUpdateMotion | kVelocityGradient;
+  const auto ra = g2p_range<D, Shape, Real, What, true, true, false>(Pa, g.G, V, q, NoKeys{}, 0, n);
+  const auto rb = g2p_range_pointwise<D, Shape, Real, What, true, true, false>(Pb, g.G, V, q, NoKeys{}, 0, n);
+  ASSERT_EQ(ra.bad, SIZE_MAX);
+  ASSERT_EQ(rb.bad, SIZE_MAX);
+  const double tol = conservation_tol<Real>();
+  EXPECT_NEAR(ra.external_work, rb.external_work, tol * (1 + std::abs(rb.external_work)));
+  for (int d = 0; d < D; ++d) {
+    double scale = 0;
+    EXPECT_LE(max_rel_diff(a.v[d], b.v[d], scale), tol) << "velocity " << d;
+    // Positions: compare the displacement dt * v_grid, relative to its own size.
+    std::vector<Real> ua(n), ub(n);
+    for (std::size_t i = 0; i < n; ++i) ua[i] = a.x[d][i] - base.x[d][i], ub[i] = b.x[d][i] - base.x[d][i];
+    EXPECT_LE(max_rel_diff(ua, ub, scale), sizeof(Real) == 8 ? 1e-9 : 2e-2) << "displacement " << d;
+  }
+  for (int c = 0; c < D * D; ++c) {
+    double scale = 0;
+    EXPECT_LE(max_rel_diff(La[c], Lb[c], scale), tol) << "velocity gradient " << c;
+    EXPECT_GT(scale, 0.0);
+  }
+}
+
+TYPED_TEST(P2G, WindowedGatherMatchesPointwise) {
+  check_window_g2p<TypeParam::D, typename TypeParam::Shape, typename TypeParam::Real>(false, 501);
+}
+TYPED_TEST(P2G, WindowedGatherMatchesPointwiseAtGridEdges) {
+  check_window_g2p<TypeParam::D, typename TypeParam::Shape, typename TypeParam::Real>(true, 502);
 }
 
 }  // namespace

@@ -12,15 +12,25 @@ namespace mmpm {
 
 struct FieldPlan {
   int fields = 1;
-  std::vector<int> field_of_material;   // per material
-  std::vector<unsigned char> rigid;     // per field
-  std::vector<int> rigid_material;      // per field: material index, or -1
-  std::vector<InteractionSpec> laws;    // the distinct interactions in use
-  std::vector<int> pair;                // fields x fields → index into laws, -1 = none
-  bool multimaterial = false;           // a multimaterial pass exists
-  bool position_separation = false;     // mx holds positions (else displacements)
+  std::vector<int> field_of_material;  // per material
+  std::vector<unsigned char> rigid;    // per field
+  std::vector<int> rigid_material;     // per field: material index, or -1
+  std::vector<InteractionSpec> laws;   // the distinct interactions in use
+  std::vector<int> pair;               // fields x fields → index into laws, -1 = none
+  bool multimaterial = false;          // a multimaterial pass exists
+  bool position_separation = false;    // mx holds positions (else displacements)
 };
 
 FieldPlan plan_fields(const Scene& scene);
+
+// Whether some interaction computes its normal from the domain gradients
+// g_i (P-33: mvg, avg, rigid). Only then does P2G scatter g.
+inline bool needs_domain_gradient(const FieldPlan& plan) {
+  for (const InteractionSpec& it : plan.laws)
+    if (it.normal == NormalMethod::mvg || it.normal == NormalMethod::avg ||
+        it.normal == NormalMethod::rigid)
+      return true;
+  return false;
+}
 
 }  // namespace mmpm

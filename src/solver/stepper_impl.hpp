@@ -19,6 +19,7 @@ Stepper<D, Shape, Real>::Stepper(const Scene& scene) : scene_(scene), plan_(plan
       traction_ramp_end_ = std::max(traction_ramp_end_, l.ramp);
     }
   }
+  domain_gradient_ = plan_.multimaterial && needs_domain_gradient(plan_);
   setup_grid();
   setup_particles(make_particles(scene));
   mm_.setup(scene, plan_, G_, mass_threshold_, dt_);
@@ -49,7 +50,7 @@ void Stepper<D, Shape, Real>::setup_grid() {
     G_.vol = gcols_.add_real("vol", n);
     for (int d = 0; d < D; ++d) {
       G_.mx[d] = gcols_.add_real(std::string("mx") + axis[d], n);
-      G_.g[d] = gcols_.add_real(std::string("g") + axis[d], n);
+      if (domain_gradient_) G_.g[d] = gcols_.add_real(std::string("g") + axis[d], n);
       G_.fi[d] = gcols_.add_real(std::string("fi") + axis[d], n);
     }
   }
@@ -120,9 +121,11 @@ void Stepper<D, Shape, Real>::setup_particles(const ParticleSeeds& seeds) {
       for (int c = 0; c < D * D; ++c) P_.F[c][p] = (c % (D + 1)) == 0 ? Real(1) : Real(0);
     P_.mat[p] = std::uint8_t(seeds.material[p]);
     body[p] = std::uint8_t(std::min(seeds.body[p], 255));
-    if (P_.field) P_.field[p] = std::uint8_t(plan_.field_of_material[std::size_t(seeds.material[p])]);
+    if (P_.field)
+      P_.field[p] = std::uint8_t(plan_.field_of_material[std::size_t(seeds.material[p])]);
     if (has_traction_) {
-      Real* base[3] = {pcols_.real("fbasex"), pcols_.real("fbasey"), D == 3 ? pcols_.real("fbasez") : nullptr};
+      Real* base[3] = {pcols_.real("fbasex"), pcols_.real("fbasey"),
+                       D == 3 ? pcols_.real("fbasez") : nullptr};
       for (int d = 0; d < D; ++d) base[d][p] = Real(seeds.traction_force[p][d]);
       pcols_.byte("load")[p] = std::uint8_t(seeds.load[p] < 0 ? 255 : seeds.load[p]);
     }
@@ -183,7 +186,8 @@ void Stepper<D, Shape, Real>::rebuild_ranges() {
   for (std::uint32_t t = 0; t < nt; ++t) tile_begin_[t + 1] += tile_begin_[t];
   for (auto& c : color_tiles_) c.clear();
   for (std::uint32_t t = 0; t < nt; ++t)
-    if (tile_begin_[t + 1] > tile_begin_[t]) color_tiles_[std::size_t(tiles_.color(t))].push_back(t);
+    if (tile_begin_[t + 1] > tile_begin_[t])
+      color_tiles_[std::size_t(tiles_.color(t))].push_back(t);
   if (!material_particles_.empty()) {
     for (auto& l : material_particles_) l.clear();
     for (std::size_t p = 0; p < n; ++p) material_particles_[P_.mat[p]].push_back(std::uint32_t(p));
@@ -201,7 +205,10 @@ void Stepper<D, Shape, Real>::zero_grid(bool mm) {
   for (int d = 0; d < D; ++d) zero(G_.p[d]), zero(G_.f[d]);
   if (mm) {
     zero(G_.vol);
-    for (int d = 0; d < D; ++d) zero(G_.mx[d]), zero(G_.g[d]), zero(G_.fi[d]);
+    for (int d = 0; d < D; ++d) {
+      zero(G_.mx[d]), zero(G_.fi[d]);
+      if (G_.g[d]) zero(G_.g[d]);
+    }
   }
 }
 
@@ -219,12 +226,19 @@ void Stepper<D, Shape, Real>::p2g(const char* label) {
       const std::uint32_t t = tiles[k];
       const std::size_t b = tile_begin_[t], e = tile_begin_[t + 1];
       std::size_t r;
-      if (plan_.multimaterial) {
+      if (plan_.multimaterial && domain_gradient_) {
+        constexpr unsigned W = What | ((What & kMultimaterial) ? unsigned(kDomainGradient) : 0u);
+        r = has_traction_ ? p2g_range<D, Shape, Real, W, true, true>(P_, G_, opt, b, e)
+                          : p2g_range<D, Shape, Real, W, true, false>(P_, G_, opt, b, e);
+      } else if (plan_.multimaterial) {
         r = has_traction_ ? p2g_range<D, Shape, Real, What, true, true>(P_, G_, opt, b, e)
                           : p2g_range<D, Shape, Real, What, true, false>(P_, G_, opt, b, e);
       } else {
-        r = has_traction_ ? p2g_range<D, Shape, Real, What & ~unsigned(kMultimaterial), false, true>(P_, G_, opt, b, e)
-                          : p2g_range<D, Shape, Real, What & ~unsigned(kMultimaterial), false, false>(P_, G_, opt, b, e);
+        r = has_traction_
+                ? p2g_range<D, Shape, Real, What & ~unsigned(kMultimaterial), false, true>(
+                      P_, G_, opt, b, e)
+                : p2g_range<D, Shape, Real, What & ~unsigned(kMultimaterial), false, false>(
+                      P_, G_, opt, b, e);
       }
       if (r != e) bad = std::min(bad, r);
     }
@@ -233,36 +247,79 @@ void Stepper<D, Shape, Real>::p2g(const char* label) {
 }
 
 template <int D, class Shape, class Real>
-template <unsigned What>
-void Stepper<D, Shape, Real>::g2p() {
+G2PParams Stepper<D, Shape, Real>::g2p_params() const {
   G2PParams q;
   q.dt = dt_;
   q.flip = scene_.simulation.flip;
   q.rigid = plan_.rigid.data();
   q.rigid_velocity = reinterpret_cast<const double(*)[3]>(rigid_velocity_now_.data());
   for (int d = 0; d < D; ++d) q.body_accel[d] = gravity_[d];
-  const KeyFn key_of{this};
+  return q;
+}
+
+// One G2P range with the scene's features as template flags.
+template <int D, class Shape, class Real>
+template <unsigned What>
+G2PRangeResult Stepper<D, Shape, Real>::g2p_range_of(const G2PParams& q, std::size_t b,
+                                                     std::size_t e) const {
+  const KeyFn key_of = key_fn();
+  auto run = [&]<bool MF, bool TR, bool GR>() {
+    return g2p_range<D, Shape, Real, What, MF, TR, GR>(P_, G_, GV_, q, key_of, b, e);
+  };
+  if (plan_.multimaterial) {
+    if (has_traction_)
+      return has_gravity_ ? run.template operator()<true, true, true>()
+                          : run.template operator()<true, true, false>();
+    return has_gravity_ ? run.template operator()<true, false, true>()
+                        : run.template operator()<true, false, false>();
+  }
+  if (has_traction_)
+    return has_gravity_ ? run.template operator()<false, true, true>()
+                        : run.template operator()<false, true, false>();
+  return has_gravity_ ? run.template operator()<false, false, true>()
+                      : run.template operator()<false, false, false>();
+}
+
+// Outcomes in a fixed order (chunk or tile index), so the external work sums
+// the same way for any number of threads.
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::collect(const std::vector<G2PRangeResult>& res) {
+  for (const auto& r : res) {
+    if (r.bad != SIZE_MAX)
+      fail_particle("g2p", r.bad, "non-finite velocity or stencil off the grid");
+    external_work_ += r.external_work;
+    if (r.moved_tile) dirty_ = true;
+  }
+}
+
+template <int D, class Shape, class Real>
+template <unsigned What>
+void Stepper<D, Shape, Real>::g2p() {
+  const G2PParams q = g2p_params();
   const std::size_t n = P_.n, chunks = chunk_count(n);
   std::vector<G2PRangeResult> res(chunks);
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (std::size_t c = 0; c < chunks; ++c) {
     const std::size_t b = c * kReduceChunk, e = std::min(n, b + kReduceChunk);
-    auto run = [&]<bool MF, bool TR, bool GR>() {
-      return g2p_range<D, Shape, Real, What, MF, TR, GR>(P_, G_, GV_, q, key_of, b, e);
-    };
-    if (plan_.multimaterial) {
-      if (has_traction_) res[c] = has_gravity_ ? run.template operator()<true, true, true>() : run.template operator()<true, true, false>();
-      else res[c] = has_gravity_ ? run.template operator()<true, false, true>() : run.template operator()<true, false, false>();
-    } else {
-      if (has_traction_) res[c] = has_gravity_ ? run.template operator()<false, true, true>() : run.template operator()<false, true, false>();
-      else res[c] = has_gravity_ ? run.template operator()<false, false, true>() : run.template operator()<false, false, false>();
+    res[c] = g2p_range_of<What>(q, b, e);
+  }
+  collect(res);
+}
+
+template <int D, class Shape, class Real>
+template <unsigned What>
+void Stepper<D, Shape, Real>::g2p_colored() {
+  const G2PParams q = g2p_params();
+  std::vector<G2PRangeResult> res(tiles_.tile_count);
+  for (const auto& tiles : color_tiles_) {
+    const std::size_t nt = tiles.size();
+#pragma omp parallel for schedule(dynamic, 1) if (P_.n >= kParallelMin)
+    for (std::size_t k = 0; k < nt; ++k) {
+      const std::uint32_t t = tiles[k];
+      res[t] = g2p_range_of<What>(q, tile_begin_[t], tile_begin_[t + 1]);
     }
   }
-  for (const auto& r : res) {
-    if (r.bad != SIZE_MAX) fail_particle("g2p", r.bad, "non-finite velocity or stencil off the grid");
-    external_work_ += r.external_work;
-    if (r.moved_tile) dirty_ = true;
-  }
+  collect(res);
 }
 
 template <int D, class Shape, class Real>
@@ -276,10 +333,17 @@ void Stepper<D, Shape, Real>::constitutive() {
       count = material_particles_[mi].size();
     }
     switch (mat.type) {
-      case MaterialType::isotropic: isotropic_update(P_, idx, count, mat.k, dt_); break;
-      case MaterialType::transverse: anisotropic_update(P_, idx, count, mat.k, dt_); break;
-      case MaterialType::neohookean: neohookean_update(P_, idx, count, mat.k, dt_); break;
-      case MaterialType::rigid: break;
+      case MaterialType::isotropic:
+        isotropic_update(P_, idx, count, mat.k, dt_);
+        break;
+      case MaterialType::transverse:
+        anisotropic_update(P_, idx, count, mat.k, dt_);
+        break;
+      case MaterialType::neohookean:
+        neohookean_update(P_, idx, count, mat.k, dt_);
+        break;
+      case MaterialType::rigid:
+        break;
     }
   }
 }
@@ -291,7 +355,8 @@ void Stepper<D, Shape, Real>::check_volumes() {
   std::size_t bad = SIZE_MAX;
 #pragma omp parallel for schedule(static) reduction(min : bad) if (n >= kParallelMin)
   for (std::size_t p = 0; p < n; ++p)
-    if (!(P_.V[p] > Real(0)) || !std::isfinite(P_.V[p]) || !std::isfinite(P_.s[0][p])) bad = std::min(bad, p);
+    if (!(P_.V[p] > Real(0)) || !std::isfinite(P_.V[p]) || !std::isfinite(P_.s[0][p]))
+      bad = std::min(bad, p);
   if (bad != SIZE_MAX) fail_particle("constitutive", bad, "J <= 0 or a non-finite stress/volume");
 }
 
@@ -371,7 +436,8 @@ void Stepper<D, Shape, Real>::update_tractions() {
   if (time_ > traction_ramp_end_ + dt_ && step_ > 1) return;
   const std::size_t n = P_.n;
   const std::uint8_t* load = pcols_.byte("load");
-  Real* base[3] = {pcols_.real("fbasex"), pcols_.real("fbasey"), D == 3 ? pcols_.real("fbasez") : nullptr};
+  Real* base[3] = {pcols_.real("fbasex"), pcols_.real("fbasey"),
+                   D == 3 ? pcols_.real("fbasez") : nullptr};
   std::vector<Real> scale(scene_.loads.size() + 1, Real(0));
   for (std::size_t l = 0; l < scene_.loads.size(); ++l) {
     const double r = scene_.loads[l].ramp;
@@ -463,18 +529,19 @@ void Stepper<D, Shape, Real>::step() {
     g2p<kUpdateMotion>();
     toc(kStageG2P);
   } else {  // MUSL: the gradient from the momenta of the updated particles
+    // Two fused passes (kernels/g2p.hpp): (1) G2P of the updated grid
+    // velocity and P2G of the new particle momenta with the same weights,
+    // (2) G2P of the velocity gradient, which then moves the particles.
+    // Both use the step's starting positions (Sulsky's MUSL).
     tic();
     for (int d = 0; d < D; ++d) {
       x_next_[d].resize(P_.n);
       P_.x_next[d] = x_next_[d].data();
     }
-    g2p<kUpdateMotion>();
-    toc(kStageG2P);
-    tic();
     const std::size_t n = G_.nodes * std::size_t(G_.fields);
     for (int d = 0; d < D; ++d) std::fill(G_.p[d], G_.p[d] + n, Real(0));
-    p2g<kMomentumOnly>("p2g");
-    toc(kStageP2G);
+    g2p_colored<kUpdateMotion | kScatterMomentum>();
+    toc(kStageG2P);
     if (mm) {
       tic();
       mm_.pass_b(G_, false);
@@ -484,16 +551,7 @@ void Stepper<D, Shape, Real>::step() {
     finish_velocities(false);
     toc(kStageGrid);
     tic();
-    g2p<kVelocityGradient>();
-    // Positions move only now, after both transfers used the step's start.
-    const std::size_t np = P_.n;
-    bool moved = false;
-#pragma omp parallel for schedule(static) reduction(|| : moved) if (np >= kParallelMin)
-    for (std::size_t p = 0; p < np; ++p) {
-      for (int d = 0; d < D; ++d) P_.x[d][p] = P_.x_next[d][p];
-      moved = moved || tile_of_position(p) != tiles_.tile_of_key(P_.key[p]);
-    }
-    if (moved) dirty_ = true;
+    g2p<kVelocityGradient | kCommitPosition>();
     for (int d = 0; d < D; ++d) P_.x_next[d] = nullptr;
     toc(kStageG2P);
   }
@@ -508,7 +566,8 @@ void Stepper<D, Shape, Real>::step() {
 }
 
 template <int D, class Shape, class Real>
-void Stepper<D, Shape, Real>::fail_particle(const char* stage, std::size_t p, const std::string& why) const {
+void Stepper<D, Shape, Real>::fail_particle(const char* stage, std::size_t p,
+                                            const std::string& why) const {
   std::ostringstream os;
   os << "unstable: stage " << stage << ", step " << step_ << ", particle " << p << " (material '"
      << materials_[P_.mat[p]].name << "', x = [";
@@ -521,38 +580,40 @@ template <int D, class Shape, class Real>
 Energies Stepper<D, Shape, Real>::energies() const {
   Energies e;
   const std::size_t n = P_.n;
-  auto parts = deterministic_sum<2>(n, [&](std::size_t b, std::size_t end, std::array<double, 2>& acc) {
-    for (std::size_t p = b; p < end; ++p) {
-      double v2 = 0;
-      for (int d = 0; d < D; ++d) v2 += double(P_.v[d][p]) * double(P_.v[d][p]);
-      acc[0] += 0.5 * double(P_.m[p]) * v2;
-      const MaterialModel& mat = materials_[P_.mat[p]];
-      if (mat.rigid()) continue;
-      if (mat.finite_strain()) {
-        double F[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-        for (int i = 0; i < D; ++i)
-          for (int j = 0; j < D; ++j) F[i * 3 + j] = double(P_.F[i * D + j][p]);
-        const double J = F[0] * (F[4] * F[8] - F[5] * F[7]) - F[1] * (F[3] * F[8] - F[5] * F[6]) +
-                         F[2] * (F[3] * F[7] - F[4] * F[6]);
-        double I1 = 0;
-        for (int c = 0; c < 9; ++c) I1 += F[c] * F[c];
-        const double lnJ = std::log(J), V0 = double(P_.m[p]) / mat.density;
-        acc[1] += V0 * (0.5 * mat.k.mu * (I1 - 3 - 2 * lnJ) + 0.5 * mat.k.lambda * lnJ * lnJ);
-      } else {
-        double s[6] = {0, 0, 0, 0, 0, 0};
-        if constexpr (D == 2) {
-          s[0] = double(P_.s[0][p]), s[1] = double(P_.s[1][p]), s[5] = double(P_.s[2][p]);
-          s[2] = double(P_.s[3][p]);
-        } else {
-          for (int c = 0; c < 6; ++c) s[c] = double(P_.s[c][p]);
+  auto parts =
+      deterministic_sum<2>(n, [&](std::size_t b, std::size_t end, std::array<double, 2>& acc) {
+        for (std::size_t p = b; p < end; ++p) {
+          double v2 = 0;
+          for (int d = 0; d < D; ++d) v2 += double(P_.v[d][p]) * double(P_.v[d][p]);
+          acc[0] += 0.5 * double(P_.m[p]) * v2;
+          const MaterialModel& mat = materials_[P_.mat[p]];
+          if (mat.rigid()) continue;
+          if (mat.finite_strain()) {
+            double F[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+            for (int i = 0; i < D; ++i)
+              for (int j = 0; j < D; ++j) F[i * 3 + j] = double(P_.F[i * D + j][p]);
+            const double J = F[0] * (F[4] * F[8] - F[5] * F[7]) -
+                             F[1] * (F[3] * F[8] - F[5] * F[6]) +
+                             F[2] * (F[3] * F[7] - F[4] * F[6]);
+            double I1 = 0;
+            for (int c = 0; c < 9; ++c) I1 += F[c] * F[c];
+            const double lnJ = std::log(J), V0 = double(P_.m[p]) / mat.density;
+            acc[1] += V0 * (0.5 * mat.k.mu * (I1 - 3 - 2 * lnJ) + 0.5 * mat.k.lambda * lnJ * lnJ);
+          } else {
+            double s[6] = {0, 0, 0, 0, 0, 0};
+            if constexpr (D == 2) {
+              s[0] = double(P_.s[0][p]), s[1] = double(P_.s[1][p]), s[5] = double(P_.s[2][p]);
+              s[2] = double(P_.s[3][p]);
+            } else {
+              for (int c = 0; c < 6; ++c) s[c] = double(P_.s[c][p]);
+            }
+            double u = 0;
+            for (int i = 0; i < 6; ++i)
+              for (int j = 0; j < 6; ++j) u += s[i] * mat.compliance[i][j] * s[j];
+            acc[1] += 0.5 * u * double(P_.V[p]);
+          }
         }
-        double u = 0;
-        for (int i = 0; i < 6; ++i)
-          for (int j = 0; j < 6; ++j) u += s[i] * mat.compliance[i][j] * s[j];
-        acc[1] += 0.5 * u * double(P_.V[p]);
-      }
-    }
-  });
+      });
   e.kinetic = parts[0];
   e.strain = parts[1];
   e.interface = mm_.interface_energy();
@@ -560,13 +621,14 @@ Energies Stepper<D, Shape, Real>::energies() const {
   e.damping = damping_loss_;
   // Kinetic energy of the grid velocity field (after the last update).
   const std::size_t total = G_.nodes * std::size_t(G_.fields);
-  auto grid_ke = deterministic_sum<1>(total, [&](std::size_t b, std::size_t end, std::array<double, 1>& acc) {
-    for (std::size_t i = b; i < end; ++i) {
-      double v2 = 0;
-      for (int d = 0; d < D; ++d) v2 += double(GV_.vel[d][i]) * double(GV_.vel[d][i]);
-      acc[0] += 0.5 * double(G_.m[i]) * v2;
-    }
-  });
+  auto grid_ke =
+      deterministic_sum<1>(total, [&](std::size_t b, std::size_t end, std::array<double, 1>& acc) {
+        for (std::size_t i = b; i < end; ++i) {
+          double v2 = 0;
+          for (int d = 0; d < D; ++d) v2 += double(GV_.vel[d][i]) * double(GV_.vel[d][i]);
+          acc[0] += 0.5 * double(G_.m[i]) * v2;
+        }
+      });
   e.kinetic_unresolved = step_ > 0 ? e.kinetic - grid_ke[0] : 0.0;
   return e;
 }
@@ -574,10 +636,12 @@ Energies Stepper<D, Shape, Real>::energies() const {
 template <int D, class Shape, class Real>
 std::vector<Reaction> Stepper<D, Shape, Real>::reactions() const {
   std::vector<Reaction> out;
-  for (std::size_t b = 0; b < boundaries_.size(); ++b) out.push_back({boundaries_[b].label, boundary_reaction_[b]});
+  for (std::size_t b = 0; b < boundaries_.size(); ++b)
+    out.push_back({boundaries_[b].label, boundary_reaction_[b]});
   for (int f = 0; f < plan_.fields; ++f) {
     const int m = plan_.rigid_material[std::size_t(f)];
-    if (m >= 0) out.push_back({"rigid:" + scene_.materials[std::size_t(m)].name, mm_.rigid_reaction(f)});
+    if (m >= 0)
+      out.push_back({"rigid:" + scene_.materials[std::size_t(m)].name, mm_.rigid_reaction(f)});
   }
   return out;
 }
@@ -591,7 +655,8 @@ io::ParticleField Stepper<D, Shape, Real>::particle_field(const std::string& nam
     out.values.resize(n * D);
     for (std::size_t p = 0; p < n; ++p)
       for (int d = 0; d < D; ++d)
-        out.values[p * D + std::size_t(d)] = double(a[d][p]) - (minus ? double((*minus)[d][p]) : 0.0);
+        out.values[p * D + std::size_t(d)] =
+            double(a[d][p]) - (minus ? double((*minus)[d][p]) : 0.0);
   };
   if (name == "position") {
     vec(P_.x, nullptr);
@@ -616,13 +681,16 @@ io::ParticleField Stepper<D, Shape, Real>::particle_field(const std::string& nam
         double F[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
         for (int i = 0; i < D; ++i)
           for (int j = 0; j < D; ++j) F[i * 3 + j] = double(P_.F[i * D + j][p]);
-        auto C = [&](int i, int j) { return F[i] * F[j] + F[3 + i] * F[3 + j] + F[6 + i] * F[6 + j]; };
+        auto C = [&](int i, int j) {
+          return F[i] * F[j] + F[3 + i] * F[3 + j] + F[6 + i] * F[6 + j];
+        };
         e[0] = 0.5 * (C(0, 0) - 1), e[1] = 0.5 * (C(1, 1) - 1), e[2] = 0.5 * (C(2, 2) - 1);
         e[3] = 0.5 * C(1, 2), e[4] = 0.5 * C(0, 2), e[5] = 0.5 * C(0, 1);
       } else if (!mat.rigid()) {
         double sv[6] = {0, 0, 0, 0, 0, 0};
         if constexpr (D == 2) {
-          sv[0] = double(P_.s[0][p]), sv[1] = double(P_.s[1][p]), sv[2] = double(P_.s[3][p]), sv[5] = double(P_.s[2][p]);
+          sv[0] = double(P_.s[0][p]), sv[1] = double(P_.s[1][p]), sv[2] = double(P_.s[3][p]),
+          sv[5] = double(P_.s[2][p]);
         } else {
           for (int c = 0; c < 6; ++c) sv[c] = double(P_.s[c][p]);
         }
@@ -640,7 +708,8 @@ io::ParticleField Stepper<D, Shape, Real>::particle_field(const std::string& nam
     }
   } else if (name == "deformation_gradient") {
     if (!P_.F[0])
-      throw InputError("output field 'deformation_gradient' needs a finite-strain (neohookean) material");
+      throw InputError(
+          "output field 'deformation_gradient' needs a finite-strain (neohookean) material");
     out.components = D * D;
     out.values.resize(n * D * D);
     for (std::size_t p = 0; p < n; ++p)
@@ -652,16 +721,19 @@ io::ParticleField Stepper<D, Shape, Real>::particle_field(const std::string& nam
   } else if (name == "material" || name == "mass" || name == "volume") {
     out.values.resize(n);
     for (std::size_t p = 0; p < n; ++p)
-      out.values[p] = name == "material" ? double(P_.mat[p]) : (name == "mass" ? double(P_.m[p]) : double(P_.V[p]));
+      out.values[p] = name == "material" ? double(P_.mat[p])
+                                         : (name == "mass" ? double(P_.m[p]) : double(P_.V[p]));
   } else {
-    throw InputError("output field '" + name + "' is unknown (position, displacement, velocity, stress, strain, "
+    throw InputError("output field '" + name +
+                     "' is unknown (position, displacement, velocity, stress, strain, "
                      "material, body, mass, volume, deformation_gradient)");
   }
   return out;
 }
 
 template <int D, class Shape, class Real>
-void Stepper<D, Shape, Real>::set_particle_field(const std::string& name, const std::vector<double>& values) {
+void Stepper<D, Shape, Real>::set_particle_field(const std::string& name,
+                                                 const std::vector<double>& values) {
   if (name != "velocity" || values.size() != P_.n * D)
     throw std::invalid_argument("set_particle_field: only 'velocity' with D values per particle");
   for (std::size_t p = 0; p < P_.n; ++p)
@@ -686,11 +758,13 @@ std::vector<io::Blob> Stepper<D, Shape, Real>::save_state() const {
   std::vector<io::Blob> out;
   const std::size_t n = P_.n;
   for (std::size_t c = 0; c < pcols_.reals.size(); ++c)
-    out.push_back(io::make_blob("p." + pcols_.real_names[c],
-                                std::vector<Real>(pcols_.reals[c].data(), pcols_.reals[c].data() + n)));
+    out.push_back(
+        io::make_blob("p." + pcols_.real_names[c],
+                      std::vector<Real>(pcols_.reals[c].data(), pcols_.reals[c].data() + n)));
   for (std::size_t c = 0; c < pcols_.bytes.size(); ++c)
-    out.push_back(io::make_blob("b." + pcols_.byte_names[c],
-                                std::vector<std::uint8_t>(pcols_.bytes[c].data(), pcols_.bytes[c].data() + n)));
+    out.push_back(io::make_blob(
+        "b." + pcols_.byte_names[c],
+        std::vector<std::uint8_t>(pcols_.bytes[c].data(), pcols_.bytes[c].data() + n)));
   out.push_back(io::make_blob("key", std::vector<std::uint32_t>(P_.key, P_.key + n)));
   out.push_back(io::make_scalar_blob("step", step_));
   out.push_back(io::make_scalar_blob("time", time_));
@@ -708,7 +782,8 @@ void Stepper<D, Shape, Real>::load_state(const std::vector<io::Blob>& blobs) {
     using T = std::remove_pointer_t<decltype(dst)>;
     std::vector<T> v;
     io::read_blob(io::find_blob(blobs, name), v);
-    if (v.size() != n) throw std::runtime_error("checkpoint does not match the scene: column " + name);
+    if (v.size() != n)
+      throw std::runtime_error("checkpoint does not match the scene: column " + name);
     std::memcpy(dst, v.data(), n * sizeof(T));
   };
   for (std::size_t c = 0; c < pcols_.reals.size(); ++c)

@@ -1,0 +1,132 @@
+// The local block of the windowed scatter (kernels/window.hpp): the sums of
+// one window's particles for every grid quantity a transfer writes, added
+// to the grid when the window changes (P2GWhat selects the quantities).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "kernels/grid_view.hpp"
+#include "kernels/particle_view.hpp"
+#include "kernels/window.hpp"
+
+namespace mmpm {
+
+// What a P2G pass scatters (bit mask).
+enum P2GWhat : unsigned {
+  kMassMomentum = 1u,     // m, p
+  kForce = 2u,            // internal force -V sigma.G, traction force S fext
+  kMultimaterial = 4u,    // mx, Omega  (ALGORITHM §1, P-10/13, P-19)
+  kMomentumOnly = 8u,     // p alone (MUSL's second transfer)
+  kDomainGradient = 16u,  // g (P-33), with kMultimaterial, for the mvg/avg/rigid normals only
+};
+
+struct P2GOptions {
+  bool position_separation = false;  // mx holds positions (else displacements)
+  double inv_thickness = 1.0;        // 2D: Omega and g are areas (P-19, P-33)
+};
+
+// The per-particle factors a transfer scatters (ALGORITHM §1-2).
+template <int D, class Real>
+struct ScatterSource {
+  static constexpr int NS = kStressComponents<D>;
+  Real m = 0;        // mass
+  Real mv[D] = {};   // momentum
+  Real vs[NS] = {};  // V sigma
+  Real fe[D] = {};   // traction force
+  Real area = 0;     // nodal-domain weight (P-19)
+  Real mw[D] = {};   // mass times displacement (or position)
+};
+
+template <int D, class Shape, class Real, unsigned What, bool Traction>
+struct WindowBlock {
+  using Win = Window<D, Shape, Real>;
+  using V = typename Win::V;
+  static constexpr int U = Win::units;
+  static constexpr bool kMass = (What & kMassMomentum) != 0;
+  static constexpr bool kMom = (What & (kMassMomentum | kMomentumOnly)) != 0;
+  static constexpr bool kFrc = (What & kForce) != 0;
+  static constexpr bool kMM = (What & kMultimaterial) != 0;
+  static constexpr bool kGrad = kMM && (What & kDomainGradient) != 0;
+
+  V am[U], ap[D][U], af[D][U], avol[U], amx[D][U], ag[D][U];
+  std::size_t current = SIZE_MAX;  // window base (with field offset) the block holds
+
+  WindowBlock() { clear(); }
+
+  void clear() {
+    for (int u = 0; u < U; ++u) {
+      if constexpr (kMass) am[u] = V{};
+      for (int d = 0; d < D; ++d) {
+        if constexpr (kMom) ap[d][u] = V{};
+        if constexpr (kFrc) af[d][u] = V{};
+        if constexpr (kMM) amx[d][u] = V{};
+        if constexpr (kGrad) ag[d][u] = V{};
+      }
+      if constexpr (kMM) avol[u] = V{};
+    }
+  }
+
+  // Adds the block to the grid at `current` (if it holds anything).
+  void flush(const GridView<D, Real>& G, const typename Win::Offsets& off) {
+    if (current == SIZE_MAX) return;
+    const std::size_t b = current;
+    for (int u = 0; u < U; ++u) {
+      if constexpr (kMass) Win::add(G.m + b, off, u, am[u]);
+      for (int d = 0; d < D; ++d) {
+        if constexpr (kMom) Win::add(G.p[d] + b, off, u, ap[d][u]);
+        if constexpr (kFrc) Win::add(G.f[d] + b, off, u, af[d][u]);
+        if constexpr (kMM) Win::add(G.mx[d] + b, off, u, amx[d][u]);
+        if constexpr (kGrad) Win::add(G.g[d] + b, off, u, ag[d][u]);
+      }
+      if constexpr (kMM) Win::add(G.vol + b, off, u, avol[u]);
+    }
+  }
+
+  // Moves the block to window base b, writing out what it held before.
+  void at(std::size_t b, const GridView<D, Real>& G, const typename Win::Offsets& off) {
+    if (b == current) return;
+    if (current != SIZE_MAX) {
+      flush(G, off);
+      clear();
+    }
+    current = b;
+  }
+
+  void accumulate(const Win& win, const ScatterSource<D, Real>& q) {
+    const V X = win.X(), GXl = win.GX();
+    for (int u = 0; u < U; ++u) {
+      const V Yu = win.Y(u);
+      const V s = X * Yu;
+      const V Gx = GXl * Yu, Gy = X * win.GY(u);
+      if constexpr (kMass) am[u] += s * q.m;
+      if constexpr (kMom)
+        for (int d = 0; d < D; ++d) ap[d][u] += s * q.mv[d];
+      if constexpr (kFrc) {
+        // f = -V sigma . G (+ S fext); 2D sigma: xx, yy, xy, zz; 3D Voigt: xx, yy, zz, yz, xz, xy
+        if constexpr (D == 2) {
+          af[0][u] -= q.vs[0] * Gx + q.vs[2] * Gy;
+          af[1][u] -= q.vs[2] * Gx + q.vs[1] * Gy;
+        } else {
+          const V Gz = X * win.GZ(u);
+          af[0][u] -= q.vs[0] * Gx + q.vs[5] * Gy + q.vs[4] * Gz;
+          af[1][u] -= q.vs[5] * Gx + q.vs[1] * Gy + q.vs[3] * Gz;
+          af[2][u] -= q.vs[4] * Gx + q.vs[3] * Gy + q.vs[2] * Gz;
+        }
+        if constexpr (Traction)
+          for (int d = 0; d < D; ++d) af[d][u] += s * q.fe[d];
+      }
+      if constexpr (kMM) {
+        avol[u] += s * q.area;
+        for (int d = 0; d < D; ++d) amx[d][u] += s * q.mw[d];
+      }
+      if constexpr (kGrad) {
+        ag[0][u] += Gx * q.area;
+        ag[1][u] += Gy * q.area;
+        if constexpr (D == 3) ag[2][u] += (X * win.GZ(u)) * q.area;
+      }
+    }
+  }
+};
+
+}  // namespace mmpm
