@@ -596,7 +596,8 @@ void check_window_g2p(bool edges, unsigned seed) {
   q.dt = 0.01;
   q.flip = 0.9;
   constexpr unsigned What = kUpdateMotion | kVelocityGradient;
-  const auto ra = g2p_range<D, Shape, Real, What, true, true, false>(Pa, g.G, V, q, NoKeys{}, 0, n);
+  // The windowed gather itself (g2p_range picks the pointwise one for linear shapes).
+  const auto ra = g2p_range_impl<D, Shape, Real, What, true, true, false, true>(Pa, g.G, V, q, NoKeys{}, 0, n);
   const auto rb = g2p_range_pointwise<D, Shape, Real, What, true, true, false>(Pb, g.G, V, q, NoKeys{}, 0, n);
   ASSERT_EQ(ra.bad, SIZE_MAX);
   ASSERT_EQ(rb.bad, SIZE_MAX);
@@ -622,6 +623,72 @@ TYPED_TEST(P2G, WindowedGatherMatchesPointwise) {
 }
 TYPED_TEST(P2G, WindowedGatherMatchesPointwiseAtGridEdges) {
   check_window_g2p<TypeParam::D, typename TypeParam::Shape, typename TypeParam::Real>(true, 502);
+}
+
+// MUSL's fused pass (G2P of the updated velocity + P2G of the new momentum,
+// kScatterMomentum) equals the two separate passes bit for bit: the same
+// velocities, end positions (x_next) and grid momentum, for the windowed and
+// the pointwise kernels. Then kCommitPosition moves x to x_next.
+template <int D, class Shape, class Real, bool Windowed>
+void check_fused_musl(unsigned seed) {
+  const bool gimp = std::string(Shape::name) == "gimp";
+  Grid<D, Real> fused(grid_cells<D>(), 2), separate(grid_cells<D>(), 2);
+  const std::size_t total = fused.G.nodes * 2;
+  std::vector<std::vector<Real>> vel(D, std::vector<Real>(total)), dvel(D, std::vector<Real>(total));
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  GridVelocity<D, Real> V;
+  for (int d = 0; d < D; ++d) {
+    for (std::size_t i = 0; i < total; ++i) vel[d][i] = Real(U(rng)), dvel[d][i] = Real(0.1 * U(rng));
+    V.vel[d] = vel[d].data();
+    V.dvel[d] = dvel[d].data();
+  }
+  const std::size_t n = D == 2 ? 6000 : 4000;
+  auto a = random_particles<D, Real>(fused.G, fused.cells, n, seed);
+  TileLayout<D> tiles;
+  tiles.setup(4, fused.cells);
+  a = a.permuted(sort_by_tile(a, fused.G, tiles));
+  auto b = a;
+  std::array<std::vector<Real>, D> xa, xb;
+  auto Pa = a.view(gimp), Pb = b.view(gimp);
+  for (int d = 0; d < D; ++d) {
+    xa[d].assign(n, 0), xb[d].assign(n, 0);
+    Pa.x_next[d] = xa[d].data(), Pb.x_next[d] = xb[d].data();
+  }
+  G2PParams q;
+  q.dt = 0.01;
+  q.flip = 0.95;
+  const auto ra = g2p_range_impl<D, Shape, Real, kUpdateMotion | kScatterMomentum, true, false, false, Windowed>(
+      Pa, fused.G, V, q, NoKeys{}, 0, n);
+  const auto rb = g2p_range_impl<D, Shape, Real, kUpdateMotion, true, false, false, Windowed>(Pb, separate.G, V, q,
+                                                                                              NoKeys{}, 0, n);
+  ASSERT_EQ(ra.bad, SIZE_MAX);
+  ASSERT_EQ(rb.bad, SIZE_MAX);
+  if constexpr (Windowed)
+    ASSERT_EQ((p2g_range<D, Shape, Real, kMomentumOnly, true, false>(Pb, separate.G, P2GOptions{}, 0, n)), n);
+  else
+    ASSERT_EQ((p2g_range_pointwise<D, Shape, Real, kMomentumOnly, true, false>(Pb, separate.G, P2GOptions{}, 0, n)), n);
+  for (int d = 0; d < D; ++d) {
+    EXPECT_TRUE(bitwise_equal(a.v[d], b.v[d])) << "velocity " << d;
+    EXPECT_TRUE(bitwise_equal(xa[d], xb[d])) << "x_next " << d;
+    EXPECT_TRUE(bitwise_equal(fused.arrays[std::size_t(1 + d)], separate.arrays[std::size_t(1 + d)])) << "momentum " << d;
+    EXPECT_TRUE(bitwise_equal(a.x[d], b.x[d])) << "x stays at the step's start";
+  }
+  EXPECT_GT(fused.sum(fused.G.p[0]) * fused.sum(fused.G.p[0]), 0.0);
+  // The gradient pass commits the positions.
+  std::array<std::vector<Real>, D * D> La;
+  for (int c = 0; c < D * D; ++c) La[std::size_t(c)].assign(n, 0), Pa.L[c] = La[std::size_t(c)].data();
+  const auto rc = g2p_range_impl<D, Shape, Real, kVelocityGradient | kCommitPosition, true, false, false, Windowed>(
+      Pa, fused.G, V, q, NoKeys{}, 0, n);
+  ASSERT_EQ(rc.bad, SIZE_MAX);
+  for (int d = 0; d < D; ++d) EXPECT_TRUE(bitwise_equal(a.x[d], xb[d])) << "x = x_next after the gradient pass";
+}
+
+TYPED_TEST(P2G, FusedMuslTransferMatchesSeparatePassesWindowed) {
+  check_fused_musl<TypeParam::D, typename TypeParam::Shape, typename TypeParam::Real, true>(601);
+}
+TYPED_TEST(P2G, FusedMuslTransferMatchesSeparatePassesPointwise) {
+  check_fused_musl<TypeParam::D, typename TypeParam::Shape, typename TypeParam::Real, false>(602);
 }
 
 }  // namespace
