@@ -94,8 +94,8 @@ void isotropic_update(const ParticleView<D, Real>& P, const std::uint32_t* idx, 
 }
 
 template <int D, class Real>
-void anisotropic_update(const ParticleView<D, Real>& P, const std::uint32_t* idx,
-                        std::size_t count, const ElasticKernelConstants& c, double dt_in) {
+void anisotropic_update(const ParticleView<D, Real>& P, const std::uint32_t* idx, std::size_t count,
+                        const ElasticKernelConstants& c, double dt_in) {
   const Real dt = Real(dt_in);
   Real C2[4][3], Z[3], C3[6][6];
   for (int i = 0; i < 4; ++i)
@@ -112,8 +112,11 @@ void anisotropic_update(const ParticleView<D, Real>& P, const std::uint32_t* idx
       if (pstress) J *= Real(1) + Z[0] * e[0] + Z[1] * e[1] + Z[2] * e[2];
       P.V[p] *= J;
     } else {
-      const Real e[6] = {dt * P.L[0][p], dt * P.L[4][p], dt * P.L[8][p],
-                         dt * (P.L[5][p] + P.L[7][p]), dt * (P.L[2][p] + P.L[6][p]),
+      const Real e[6] = {dt * P.L[0][p],
+                         dt * P.L[4][p],
+                         dt * P.L[8][p],
+                         dt * (P.L[5][p] + P.L[7][p]),
+                         dt * (P.L[2][p] + P.L[6][p]),
                          dt * (P.L[1][p] + P.L[3][p])};
       for (int i = 0; i < 6; ++i) {
         Real ds = 0;
@@ -128,8 +131,8 @@ void anisotropic_update(const ParticleView<D, Real>& P, const std::uint32_t* idx
 // Compressible neo-Hookean: sigma = mu/J (B - I) + lambda ln(J)/J I,
 // F <- (I + dt L) F. Plane strain in 2D (F_zz = 1).
 template <int D, class Real>
-void neohookean_update(const ParticleView<D, Real>& P, const std::uint32_t* idx,
-                       std::size_t count, const ElasticKernelConstants& c, double dt_in) {
+void neohookean_update(const ParticleView<D, Real>& P, const std::uint32_t* idx, std::size_t count,
+                       const ElasticKernelConstants& c, double dt_in) {
   const Real dt = Real(dt_in), lam = Real(c.lambda), mu = Real(c.mu);
   const Real inv_rho = Real(1 / c.density);
   for_particles(idx, count, [&](std::size_t p) {

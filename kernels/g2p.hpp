@@ -69,7 +69,7 @@ struct G2PGather {
       return St{};
   }
 
-  bool build(const ParticleView<D, Real>& P, std::size_t p) {
+  [[gnu::always_inline]] bool build(const ParticleView<D, Real>& P, std::size_t p) {
     if constexpr (Windowed)
       return w.build(P, p);
     else
@@ -78,8 +78,8 @@ struct G2PGather {
 
   // vn, dv: velocity and its change over the step; L row-major dv_a/dx_b.
   template <bool Motion, bool Gradient>
-  void gather(const GridVelocity<D, Real>& V, std::size_t field_offset, Real* vn, Real* dv,
-              Real* L) const {
+  [[gnu::always_inline]] void gather(const GridVelocity<D, Real>& V, std::size_t field_offset,
+                                     Real* vn, Real* dv, Real* L) const {
     const std::size_t b = w.base + field_offset;
     if constexpr (!Windowed) {
       for (int k = 0; k < St::count; ++k) {
@@ -101,28 +101,43 @@ struct G2PGather {
       using Vec = typename Win::V;
       constexpr int Ln = Win::L;
       const auto& off = offsets;
-      for (int d = 0; d < D; ++d) {
-        Vec A{}, B{}, C{}, Q{};
-        const Real* vel = V.vel[d] + b;
-        const Real* dvel = V.dvel[d] + b;
-        for (int u = 0; u < Win::units; ++u) {
-          const Vec vu = Win::load(vel, off, u);
-          A += w.Y(u) * vu;
+      Vec A[D] = {}, B[D] = {}, C[D] = {}, Q[D] = {};
+      static_for<Win::units>([&](auto uc) {
+        constexpr int u = decltype(uc)::value;
+        const Vec Yu = w.template Y<u>(), GYu = w.template GY<u>(), GZu = w.template GZ<u>();
+        for (int d = 0; d < D; ++d) {
+          const Vec vu = Win::template load<u>(V.vel[d] + b, off);
+          A[d] += Yu * vu;
           if constexpr (Gradient) {
-            B += w.GY(u) * vu;
-            if constexpr (D == 3) C += w.GZ(u) * vu;
+            B[d] += GYu * vu;
+            if constexpr (D == 3) C[d] += GZu * vu;
           }
-          if constexpr (Motion) Q += w.Y(u) * Win::load(dvel, off, u);
+          if constexpr (Motion) Q[d] += Yu * Win::template load<u>(V.dvel[d] + b, off);
         }
-        const Vec X = w.X();
-        if constexpr (Motion) {
-          vn[d] = lanes_sum<Real, Ln>(X * A);
-          dv[d] = lanes_sum<Real, Ln>(X * Q);
-        }
-        if constexpr (Gradient) {
-          L[d * D + 0] = lanes_sum<Real, Ln>(w.GX() * A);
-          L[d * D + 1] = lanes_sum<Real, Ln>(X * B);
-          if constexpr (D == 3) L[d * D + 2] = lanes_sum<Real, Ln>(X * C);
+      });
+      const Vec X = w.X(), GX = w.GX();
+      for (int d = 0; d < D; ++d) {
+        if constexpr (Ln >= 4) {
+          // Four dot products at once (a shuffle tree, not four serial sums).
+          const Lanes<Real, 4> s1 =
+              lanes_sum4(lanes_fold4<Real, Ln>(X * A[d]), lanes_fold4<Real, Ln>(X * Q[d]),
+                         lanes_fold4<Real, Ln>(GX * A[d]), lanes_fold4<Real, Ln>(X * B[d]));
+          if constexpr (Motion) vn[d] = s1[0], dv[d] = s1[1];
+          if constexpr (Gradient) {
+            L[d * D + 0] = s1[2];
+            L[d * D + 1] = s1[3];
+            if constexpr (D == 3) L[d * D + 2] = lanes_sum<Real, Ln>(X * C[d]);
+          }
+        } else {
+          if constexpr (Motion) {
+            vn[d] = lanes_sum<Real, Ln>(X * A[d]);
+            dv[d] = lanes_sum<Real, Ln>(X * Q[d]);
+          }
+          if constexpr (Gradient) {
+            L[d * D + 0] = lanes_sum<Real, Ln>(GX * A[d]);
+            L[d * D + 1] = lanes_sum<Real, Ln>(X * B[d]);
+            if constexpr (D == 3) L[d * D + 2] = lanes_sum<Real, Ln>(X * C[d]);
+          }
         }
       }
     }
@@ -221,8 +236,8 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
 }
 
 // The solver's G2P: windowed for the 4-node windows; pointwise for linear
-// shapes (bench: the 2-node gather is faster node by node than through
-// the flat window's horizontal sums) and for grids too small for a window.
+// shapes (bench: node by node beats the flat window's horizontal sums, also
+// with MUSL's momentum scatter fused in) and for grids too small for a window.
 template <int D, class Shape, class Real, unsigned What, bool MultiField, bool Traction,
           bool Gravity, class KeyFn>
 G2PRangeResult g2p_range(const ParticleView<D, Real>& P, const GridView<D, Real>& G,

@@ -11,16 +11,16 @@
 namespace mmpm {
 
 template <int D, class Real>
-struct GridVelocity {  // per field and node, same layout as GridView
+struct GridVelocity {           // per field and node, same layout as GridView
   std::array<Real*, D> vel{};   // velocity after the update
   std::array<Real*, D> dvel{};  // velocity change over the step (FLIP)
 };
 
 struct GridUpdateParams {
   double dt = 0;
-  double damping = 0;          // grid damping alpha: a = f/m - alpha v
-  double mass_threshold = 0;   // below: the field is empty at that node
-  double body_accel[3] = {0, 0, 0};  // gravity on deformable fields
+  double damping = 0;                           // grid damping alpha: a = f/m - alpha v
+  double mass_threshold = 0;                    // below: the field is empty at that node
+  double body_accel[3] = {0, 0, 0};             // gravity on deformable fields
   const unsigned char* rigid = nullptr;         // per field
   const double (*rigid_velocity)[3] = nullptr;  // per field, at t + dt
   bool has_interface_force = false;

@@ -18,13 +18,13 @@ struct GridView {
   std::size_t nodes = 0;  // product of nodes_per_dim[0..D)
   int fields = 1;         // material velocity fields
 
-  Real* m = nullptr;                    // mass                      (P-5)
-  std::array<Real*, D> p{};             // momentum                  (P-6)
-  std::array<Real*, D> f{};             // internal + external force
-  std::array<Real*, D> mx{};            // mass-weighted position / displacement (P-10, P-13)
-  Real* vol = nullptr;                  // nodal domain Omega        (P-19)
-  std::array<Real*, D> g{};             // domain gradient           (P-33)
-  std::array<Real*, D> fi{};            // interface force           (P-17)
+  Real* m = nullptr;          // mass                      (P-5)
+  std::array<Real*, D> p{};   // momentum                  (P-6)
+  std::array<Real*, D> f{};   // internal + external force
+  std::array<Real*, D> mx{};  // mass-weighted position / displacement (P-10, P-13)
+  Real* vol = nullptr;        // nodal domain Omega        (P-19)
+  std::array<Real*, D> g{};   // domain gradient           (P-33)
+  std::array<Real*, D> fi{};  // interface force           (P-17)
 
   std::size_t at(int field, std::size_t node) const { return std::size_t(field) * nodes + node; }
   // Node coordinates from the flat index (x fastest).

@@ -68,4 +68,28 @@ inline Real lanes_sum(const V& a) {
   return s;
 }
 
+// Halves added until 4 lanes remain (a vector of 4, 8 or 16 lanes).
+template <class Real, int n, class V>
+inline Lanes<Real, 4> lanes_fold4(const V& v) {
+  if constexpr (n == 4) {
+    return v;
+  } else {
+    const auto halves = []<std::size_t... I>(const V& a, std::index_sequence<I...>) {
+      return __builtin_shufflevector(a, a, int(I)...) +
+             __builtin_shufflevector(a, a, int(I + n / 2)...);
+    };
+    return lanes_fold4<Real, n / 2>(halves(v, std::make_index_sequence<n / 2>{}));
+  }
+}
+
+// The lane sums of four 4-lane vectors, as one vector {sum a, sum b, sum c, sum d}.
+template <class V>
+inline V lanes_sum4(const V& a, const V& b, const V& c, const V& d) {
+  const V ab =
+      __builtin_shufflevector(a, b, 0, 4, 2, 6) + __builtin_shufflevector(a, b, 1, 5, 3, 7);
+  const V cd =
+      __builtin_shufflevector(c, d, 0, 4, 2, 6) + __builtin_shufflevector(c, d, 1, 5, 3, 7);
+  return __builtin_shufflevector(ab, cd, 0, 1, 4, 5) + __builtin_shufflevector(ab, cd, 2, 3, 6, 7);
+}
+
 }  // namespace mmpm

@@ -43,15 +43,15 @@ struct PairParams {
 // Everything the two passes need besides the grid.
 template <int D, class Real>
 struct MMConfig {
-  int fields = 0;                             // F: material velocity fields
-  const int* pair = nullptr;                  // F*F table: [a*F+b] = index into params, -1 = separate
+  int fields = 0;             // F: material velocity fields
+  const int* pair = nullptr;  // F*F table: [a*F+b] = index into params, -1 = separate
   const PairParams<Real>* params = nullptr;
-  const unsigned char* rigid = nullptr;       // F flags; null = no rigid field
-  Real dt = 0;                                // time step
+  const unsigned char* rigid = nullptr;  // F flags; null = no rigid field
+  Real dt = 0;                           // time step
   // 2D only: multiplies the area (P-20). Use the thickness t when grid.vol holds areas
   // (Σ S_ip A_p, as in P-19); use 1 when grid.vol already holds A_p·t.
   Real thickness = 1;
-  Real mass_threshold = 0;                    // a field with m <= threshold is empty at the node
+  Real mass_threshold = 0;  // a field with m <= threshold is empty at the node
   // Include Δf_i of (P-27) from grid.f in the force limit and in the exact integration.
   // Off by default (ALGORITHM §2: neglected in pass A).
   bool use_force_difference = false;

@@ -179,9 +179,9 @@ inline Real oscillator_sin_term(Real theta) {
   if (theta < Real(0.5)) {
     const Real x2 = theta * theta;
     return x2 / Real(6) *
-           (Real(1) - x2 / Real(20) *
-                          (Real(1) - x2 / Real(42) *
-                                         (Real(1) - x2 / Real(72) * (Real(1) - x2 / Real(110)))));
+           (Real(1) -
+            x2 / Real(20) *
+                (Real(1) - x2 / Real(42) * (Real(1) - x2 / Real(72) * (Real(1) - x2 / Real(110)))));
   }
   return Real(1) - std::sin(theta) / theta;
 }

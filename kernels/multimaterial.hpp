@@ -21,11 +21,11 @@
 #include <vector>
 
 #include "kernels/grid_view.hpp"
-#include "kernels/reduce.hpp"
 #include "kernels/mm_common.hpp"
 #include "kernels/mm_contact.hpp"
 #include "kernels/mm_interface.hpp"
 #include "kernels/mm_normals.hpp"
+#include "kernels/reduce.hpp"
 
 namespace mmpm {
 
@@ -52,12 +52,12 @@ struct InteractionResult {
 // Geometry and kinematics of a pair at a node (§3, P-7 … P-15).
 template <int D, class Real>
 struct PairGeometry {
-  VecD<D, Real> n{};      // unit normal a → b
-  VecD<D, Real> dp{};     // Δp_a (P-7), rigid b: (P-29)
-  VecD<D, Real> t{};      // unit tangent along the tangential opening (P-15)
-  Real delta_n = 0;       // δ·n (P-12)
-  Real delta_t = 0;       // |δ − δ_n n| ≥ 0 (P-15)
-  Real h_perp = 0;        // (P-22)
+  VecD<D, Real> n{};   // unit normal a → b
+  VecD<D, Real> dp{};  // Δp_a (P-7), rigid b: (P-29)
+  VecD<D, Real> t{};   // unit tangent along the tangential opening (P-15)
+  Real delta_n = 0;    // δ·n (P-12)
+  Real delta_t = 0;    // |δ − δ_n n| ≥ 0 (P-15)
+  Real h_perp = 0;     // (P-22)
   bool valid = false;
 };
 
@@ -189,9 +189,9 @@ struct DirectionOutcome {
 };
 
 template <class Real>
-DirectionOutcome<Real> interface_direction(const PairParams<Real>& pp, bool perfect,
-                                           Real stiffness, Real traction, Real energy_density,
-                                           Real area, Real m_red, Real dt, Real separation,
+DirectionOutcome<Real> interface_direction(const PairParams<Real>& pp, bool perfect, Real stiffness,
+                                           Real traction, Real energy_density, Real area,
+                                           Real m_red, Real dt, Real separation,
                                            Real momentum_change, Real force_diff) {
   DirectionOutcome<Real> o;
   if (perfect) {  // always stick, zero energy, no force limit computation
@@ -211,8 +211,8 @@ DirectionOutcome<Real> interface_direction(const PairParams<Real>& pp, bool perf
   }
   const Real force = traction * area;
   if (pp.force_limit &&
-      exceeds_force_limit(force, force_limit_component(m_red, dt, separation, momentum_change,
-                                                       force_diff))) {
+      exceeds_force_limit(
+          force, force_limit_component(m_red, dt, separation, momentum_change, force_diff))) {
     o.stick = o.limited = true;
     return o;
   }
@@ -248,8 +248,8 @@ InteractionResult<D, Real> interact_pass_a(const MaterialSide<D, Real>& a,
                                            const MaterialSide<D, Real>& b, bool b_is_rigid,
                                            const PairParams<Real>& pp, Real sign,
                                            const std::array<Real, 3>& node_position,
-                                           const std::array<Real, 3>& h, Real dt,
-                                           Real thickness, bool use_force_difference) {
+                                           const std::array<Real, 3>& h, Real dt, Real thickness,
+                                           bool use_force_difference) {
   InteractionResult<D, Real> r;
   const PairGeometry<D, Real> G =
       screened_geometry<D, Real>(a, b, b_is_rigid, pp, sign, node_position, h);
@@ -265,11 +265,11 @@ InteractionResult<D, Real> interact_pass_a(const MaterialSide<D, Real>& a,
   if (use_force_difference) df = force_difference<D, Real>(a.m, a.f, b.m, b.f, b_is_rigid);
 
   const DirectionOutcome<Real> on =
-      interface_direction(pp, tr.perfect_n, tr.stiffness_n, tr.normal, tr.energy_n, area, m_red,
-                          dt, dn, dot<D, Real>(G.dp, G.n), dot<D, Real>(df, G.n));
+      interface_direction(pp, tr.perfect_n, tr.stiffness_n, tr.normal, tr.energy_n, area, m_red, dt,
+                          dn, dot<D, Real>(G.dp, G.n), dot<D, Real>(df, G.n));
   const DirectionOutcome<Real> ot =
-      interface_direction(pp, tr.perfect_t, tr.stiffness_t, tr.tangential, tr.energy_t, area,
-                          m_red, dt, G.delta_t, dot<D, Real>(G.dp, G.t), dot<D, Real>(df, G.t));
+      interface_direction(pp, tr.perfect_t, tr.stiffness_t, tr.tangential, tr.energy_t, area, m_red,
+                          dt, G.delta_t, dot<D, Real>(G.dp, G.t), dot<D, Real>(df, G.t));
   r.stick = (on.stick ? kStickNormal : 0) | (ot.stick ? kStickTangential : 0);
   if (on.stick && ot.stick) r.stick |= kStickBoth;
   r.limited = int(on.limited) + int(ot.limited);
@@ -294,8 +294,8 @@ InteractionResult<D, Real> interact_pass_b(const MaterialSide<D, Real>& a,
       screened_geometry<D, Real>(a, b, b_is_rigid, pp, sign, node_position, h);
   if (!G.valid) return r;
   if (pp.law != Law::interface)
-    return contact_result<D, Real>(
-        G, pp, corrected_normal_separation(pp.separation, G.delta_n, G.h_perp));
+    return contact_result<D, Real>(G, pp,
+                                   corrected_normal_separation(pp.separation, G.delta_n, G.h_perp));
   r.evaluated = true;
   r.momentum_change = directional_stick_change<D, Real>(stick_flags, G.dp, G.n);
   return r;
@@ -325,8 +325,8 @@ PassNeeds pass_needs(const MMConfig<D, Real>& cfg, bool pass_a) {
     if (cfg.pair[k] < 0) continue;
     const NormalMethod method = cfg.params[cfg.pair[k]].normal_method;
     needs.position |= method == NormalMethod::radial;
-    needs.gradient |= method == NormalMethod::mvg || method == NormalMethod::avg ||
-                      method == NormalMethod::rigid;
+    needs.gradient |=
+        method == NormalMethod::mvg || method == NormalMethod::avg || method == NormalMethod::rigid;
   }
   return needs;
 }
@@ -409,8 +409,8 @@ void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::si
     if (idx < 0 || cfg.params[idx].law == Law::separate) return nullptr;
     return &cfg.params[idx];
   };
-  auto interact = [&](const MaterialSide<D, Real>& a, const MaterialSide<D, Real>& b,
-                      bool b_rigid, const PairParams<Real>& pp, int field_a) {
+  auto interact = [&](const MaterialSide<D, Real>& a, const MaterialSide<D, Real>& b, bool b_rigid,
+                      const PairParams<Real>& pp, int field_a) {
     const Real sign = field_a == pp.first_field ? Real(1) : Real(-1);
     if constexpr (kPassA) {
       return interact_pass_a<D, Real>(a, b, b_rigid, pp, sign, x_node, grid.h, cfg.dt,
@@ -440,7 +440,8 @@ void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::si
     const bool b_rigid = rigid0 || rigid1;
     const InteractionResult<D, Real> r = interact(nf.side[ia], nf.side[ib], b_rigid, *pp, fa);
     apply(fa, r.momentum_change, r.force, Real(1));
-    if (b_rigid) add_reaction<D, Real>(cs, fb, reaction_change<D, Real, kPassA>(r), r.force, inv_dt);
+    if (b_rigid)
+      add_reaction<D, Real>(cs, fb, reaction_change<D, Real, kPassA>(r), r.force, inv_dt);
     else
       apply(fb, r.momentum_change, r.force, Real(-1));
     if constexpr (kPassA) {
@@ -480,7 +481,8 @@ void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::si
     change[ia] = r.momentum_change;
     force[ia] = r.force;
     if (b_rigid)
-      add_reaction<D, Real>(cs, nf.field[partner], reaction_change<D, Real, kPassA>(r), r.force, inv_dt);
+      add_reaction<D, Real>(cs, nf.field[partner], reaction_change<D, Real, kPassA>(r), r.force,
+                            inv_dt);
     if constexpr (kPassA) {
       // Energy once per node among lumped interactions, once per rigid interaction (§6).
       if (b_rigid) {
@@ -515,8 +517,8 @@ void run_pass(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
   std::vector<double> reactions(chunks * reaction_stride, 0.0);
   for (std::size_t c = 0; c < chunks; ++c) partial[c].reaction = &reactions[c * reaction_stride];
 
-  // A node costs a few hundred ns: below ~1000 nodes one thread is faster
-  // than waking a team.
+    // A node costs a few hundred ns: below ~1000 nodes one thread is faster
+    // than waking a team.
 #pragma omp parallel if (n >= kParallelNodes)
   {
     NodeFields<D, Real> nf;

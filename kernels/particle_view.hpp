@@ -15,12 +15,12 @@ inline constexpr int kStressComponents = D == 2 ? 4 : 6;
 template <int D, class Real>
 struct ParticleView {
   std::size_t n = 0;
-  std::array<Real*, D> x{};       // position
-  std::array<Real*, D> v{};       // velocity
-  Real* m = nullptr;              // mass
-  Real* V = nullptr;              // current volume (area * thickness in 2D)
+  std::array<Real*, D> x{};                     // position
+  std::array<Real*, D> v{};                     // velocity
+  Real* m = nullptr;                            // mass
+  Real* V = nullptr;                            // current volume (area * thickness in 2D)
   std::array<Real*, kStressComponents<D>> s{};  // Cauchy stress
-  std::array<Real*, D * D> L{};   // velocity gradient from G2P, row-major dv_a/dx_b
+  std::array<Real*, D * D> L{};                 // velocity gradient from G2P, row-major dv_a/dx_b
   std::array<Real*, D * D> F{};   // deformation gradient (finite-strain materials only)
   std::array<Real*, D> x0{};      // initial position (displacement output / separation)
   std::array<Real*, D> lp{};      // uGIMP half-width in cell units (gimp only)

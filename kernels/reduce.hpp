@@ -15,7 +15,9 @@ inline constexpr std::size_t kReduceChunk = 4096;
 // the work (a few microseconds per parallel region).
 inline constexpr std::size_t kParallelMin = 8192;
 
-inline std::size_t chunk_count(std::size_t n) { return (n + kReduceChunk - 1) / kReduceChunk; }
+inline std::size_t chunk_count(std::size_t n) {
+  return (n + kReduceChunk - 1) / kReduceChunk;
+}
 
 // body(begin, end, acc) adds K values into acc for indices [begin, end).
 template <int K, class Body>

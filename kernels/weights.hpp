@@ -14,8 +14,8 @@ template <int D, class Shape, class Real>
 struct Stencil {
   static constexpr int S = Shape::S;
   static constexpr int count = D == 2 ? S * S : S * S * S;
-  std::size_t base = 0;              // node index of the lowest corner (field 0)
-  std::array<Real, count> w{};       // S_ip, x fastest
+  std::size_t base = 0;                        // node index of the lowest corner (field 0)
+  std::array<Real, count> w{};                 // S_ip, x fastest
   std::array<std::array<Real, D>, count> g{};  // G_ip
   std::array<std::size_t, count> node{};       // node offsets relative to base
 

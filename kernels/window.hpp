@@ -11,10 +11,10 @@
 //    pointwise scatter, docs/performance.md);
 //  - the window is a fixed number of fixed-length vectors ("units"), so the
 //    transfers are vector multiply-adds where a 3-node stencil starting
-//    anywhere did not vectorise:
-//      W = 4 (uGIMP, B-splines): a unit is one row of 4 nodes along x
-//        (4 doubles = 256 bits), W^(D-1) units;
-//      W = 2 (linear): the whole window is one unit (2D: 4 lanes, 3D: 8).
+//    anywhere did not vectorise. A unit is RU consecutive rows of W nodes
+//    along x, as many as fill 64 bytes (one AVX-512 register; two AVX2
+//    registers elsewhere): 2D uGIMP in double = 2 units of 2 rows x 4
+//    nodes; 2D linear = the whole window (4 lanes), 3D linear = 8 lanes.
 // Window nodes outside the particle's reach get weight 0 (Shape::lanes()
 // evaluates every window node). Near the grid's edge the window is shifted
 // inward, so it never leaves the grid; a particle whose own stencil leaves
@@ -37,20 +37,31 @@
 
 namespace mmpm {
 
+template <int N, class F>
+[[gnu::always_inline]] inline void static_for(F&& f) {
+  [&]<int... u>(std::integer_sequence<int, u...>) {
+    (f(std::integral_constant<int, u>{}), ...);
+  }
+  (std::make_integer_sequence<int, N>{});
+}
+
 template <int D, class Shape, class Real>
 struct Window {
   static constexpr int W = Shape::W;
   static constexpr int N = D == 2 ? W * W : W * W * W;  // window nodes
-  static constexpr bool flat = W == 2;                  // one unit holds the whole window
-  static constexpr int L = flat ? N : W;                // lanes per unit
-  static constexpr int units = N / L;
+  static constexpr int R = N / W;                       // rows of W nodes along x
+  static constexpr int RU = std::min<int>(R, 64 / int(W * sizeof(Real)));  // rows per unit
+  static constexpr int L = W * RU;                                         // lanes per unit
+  static constexpr int units = R / RU;
+  static constexpr bool flat = units == 1 && W == 2;  // linear: one unit holds the window
   // All directions' 1D weights in one vector (lane d * W + k: direction d,
   // node k), so the shape function runs once per particle, not once per
   // direction. 3D pads to 4 directions (vector widths are powers of two).
   static constexpr int DP = D == 2 ? 2 : 4;
   using V = Lanes<Real, L>;        // one unit
+  using Row = Lanes<Real, W>;      // one row
   using VA = Lanes<Real, W * DP>;  // every direction's 1D weights
-  using Offsets = std::array<std::size_t, flat ? N / 2 : units>;
+  using Offsets = std::array<std::size_t, R>;
 
   std::size_t base = 0;  // node index of the window's lowest corner (field 0)
   VA wa{};               // 1D weights, lane d * W + k
@@ -64,57 +75,52 @@ struct Window {
     return true;
   }
 
-  // Offsets from base of the contiguous runs of nodes along x: per unit
-  // (rows, y index u % W, z index u / W), or per node pair (flat: pair q at
-  // y index q % 2, z index q / 2).
+  // Offsets from base of the rows (row r: y index r % W, z index r / W).
   static Offsets offsets(const GridView<D, Real>& G) {
     Offsets off{};
     const std::size_t nx = std::size_t(G.nodes_per_dim[0]);
     const std::size_t nxy = nx * std::size_t(G.nodes_per_dim[1]);
-    for (std::size_t q = 0; q < off.size(); ++q)
-      off[q] = nx * (q % std::size_t(W)) + nxy * (q / std::size_t(W));
+    for (std::size_t r = 0; r < off.size(); ++r)
+      off[r] = nx * (r % std::size_t(W)) + nxy * (r / std::size_t(W));
     return off;
   }
 
-  // Grid values of unit u (unaligned: windows start at any node).
-  static V load(const Real* a, const Offsets& off, int u) {
-    if constexpr (!flat) {
-      return lanes_load<V>(a + off[std::size_t(u)]);
-    } else {
-      V v{};
-      for (int q = 0; q < N / 2; ++q) {
-        const Lanes<Real, 2> t = lanes_load<Lanes<Real, 2>>(a + off[std::size_t(q)]);
-        v[2 * q] = t[0];
-        v[2 * q + 1] = t[1];
-      }
-      return v;
-    }
+  // Grid values of unit u (rows are unaligned: windows start at any node),
+  // rows joined with shuffles, not through memory.
+  template <int u>
+  static V load(const Real* a, const Offsets& off) {
+    return join<u * RU, RU>(a, off);
   }
-  static void add(Real* a, const Offsets& off, int u, const V& v) {
-    if constexpr (!flat) {
-      Real* row = a + off[std::size_t(u)];
-      lanes_store(row, lanes_load<V>(row) + v);
-    } else {
-      for (int q = 0; q < N / 2; ++q) {
-        Real* pair = a + off[std::size_t(q)];
-        Lanes<Real, 2> t = lanes_load<Lanes<Real, 2>>(pair);
-        t[0] += v[2 * q];
-        t[1] += v[2 * q + 1];
-        lanes_store(pair, t);
-      }
-    }
+  template <int u>
+  static void add(Real* a, const Offsets& off, const V& v) {
+    const V sum = load<u>(a, off) + v;
+    static_for<RU>([&](auto k) {
+      lanes_store(a + off[std::size_t(u * RU + k)], row_of<k>(sum, std::make_index_sequence<W>{}));
+    });
   }
 
-  // The lane vectors of the header comment.
-  V X() const { return x_lanes(wa); }
-  V GX() const { return x_lanes(dwa); }
-  V Y(int u) const { return yz(wa, wa, u); }
-  V GY(int u) const { return yz(dwa, wa, u); }
-  V GZ(int u) const {
+  // The lane vectors of the header comment (lane k of unit u: x node k % W,
+  // row u * RU + k / W).
+  V X() const {
+    return pick(wa, [](int k) { return k % W; });
+  }
+  V GX() const {
+    return pick(dwa, [](int k) { return k % W; });
+  }
+  template <int u>
+  V Y() const {
+    return yz<u>(wa, wa);
+  }
+  template <int u>
+  V GY() const {
+    return yz<u>(dwa, wa);
+  }
+  template <int u>
+  V GZ() const {
     if constexpr (D == 2)
       return V{};
     else
-      return yz(wa, dwa, u);
+      return yz<u>(wa, dwa);
   }
 
   explicit Window(const GridView<D, Real>& G) {
@@ -168,34 +174,45 @@ struct Window {
   static VA spread(const VA& t, std::index_sequence<I...>) {
     return __builtin_shufflevector(t, t, int(I / W)...);
   }
-  // Lane j of the unit: x node (j % W) for rows; (j % 2) for the flat window.
-  template <std::size_t... I>
-  static V x_lanes_of(const VA& a, std::index_sequence<I...>) {
-    return __builtin_shufflevector(a, a, int(I % W)...);
+  // Lanes of a picked by a constexpr index function of the unit lane.
+  template <class F, std::size_t... I>
+  static V pick_of(const VA& a, F, std::index_sequence<I...>) {
+    return __builtin_shufflevector(a, a, F{}(int(I))...);
   }
-  static V x_lanes(const VA& a) { return x_lanes_of(a, std::make_index_sequence<L>{}); }
-  // Flat window, lane i + 2 j + 4 l: y lane W + j, z lane 2W + l.
-  template <std::size_t... I>
-  static V y_lanes_of(const VA& a, std::index_sequence<I...>) {
-    return __builtin_shufflevector(a, a, int(W + (I / 2) % 2)...);
-  }
-  template <std::size_t... I>
-  static V z_lanes_of(const VA& a, std::index_sequence<I...>) {
-    return __builtin_shufflevector(a, a, int(2 * W + (I / 4) % 2)...);
+  template <class F>
+  static V pick(const VA& a, F f) {
+    return pick_of(a, f, std::make_index_sequence<L>{});
   }
   // Product of the y factor (from ya) and the z factor (from za) of unit u.
-  static V yz(const VA& ya, const VA& za, int u) {
-    if constexpr (flat) {
-      constexpr auto seq = std::make_index_sequence<L>{};
-      if constexpr (D == 2)
-        return y_lanes_of(ya, seq);
-      else
-        return y_lanes_of(ya, seq) * z_lanes_of(za, seq);
+  template <int u>
+  static V yz(const VA& ya, const VA& za) {
+    constexpr auto jy = [](int k) { return W + (u * RU + k / W) % W; };
+    if constexpr (D == 2) {
+      return pick(ya, jy);
     } else {
-      const int j = u % W, l = u / W;
-      const Real y = ya[W + j];
-      return V{} + (D == 3 ? y * za[2 * W + l] : y);
+      constexpr auto lz = [](int k) { return 2 * W + (u * RU + k / W) / W; };
+      return pick(ya, jy) * pick(za, lz);
     }
+  }
+  // Rows first .. first + count - 1 joined into one vector.
+  template <int first, int count>
+  static Lanes<Real, W * count> join(const Real* a, const Offsets& off) {
+    if constexpr (count == 1) {
+      return lanes_load<Row>(a + off[std::size_t(first)]);
+    } else {
+      const auto lo = join<first, count / 2>(a, off);
+      const auto hi = join<first + count / 2, count / 2>(a, off);
+      return concat(lo, hi, std::make_index_sequence<W * count>{});
+    }
+  }
+  template <class H, std::size_t... I>
+  static Lanes<Real, W * 2 * (sizeof(H) / sizeof(Real) / W)> concat(const H& lo, const H& hi,
+                                                                    std::index_sequence<I...>) {
+    return __builtin_shufflevector(lo, hi, int(I)...);
+  }
+  template <int k, std::size_t... I>
+  static Row row_of(const V& v, std::index_sequence<I...>) {
+    return __builtin_shufflevector(v, v, int(k * W + I)...);
   }
 };
 

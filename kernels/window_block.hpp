@@ -71,16 +71,17 @@ struct WindowBlock {
   void flush(const GridView<D, Real>& G, const typename Win::Offsets& off) {
     if (current == SIZE_MAX) return;
     const std::size_t b = current;
-    for (int u = 0; u < U; ++u) {
-      if constexpr (kMass) Win::add(G.m + b, off, u, am[u]);
+    static_for<U>([&](auto uc) {
+      constexpr int u = decltype(uc)::value;
+      if constexpr (kMass) Win::template add<u>(G.m + b, off, am[u]);
       for (int d = 0; d < D; ++d) {
-        if constexpr (kMom) Win::add(G.p[d] + b, off, u, ap[d][u]);
-        if constexpr (kFrc) Win::add(G.f[d] + b, off, u, af[d][u]);
-        if constexpr (kMM) Win::add(G.mx[d] + b, off, u, amx[d][u]);
-        if constexpr (kGrad) Win::add(G.g[d] + b, off, u, ag[d][u]);
+        if constexpr (kMom) Win::template add<u>(G.p[d] + b, off, ap[d][u]);
+        if constexpr (kFrc) Win::template add<u>(G.f[d] + b, off, af[d][u]);
+        if constexpr (kMM) Win::template add<u>(G.mx[d] + b, off, amx[d][u]);
+        if constexpr (kGrad) Win::template add<u>(G.g[d] + b, off, ag[d][u]);
       }
-      if constexpr (kMM) Win::add(G.vol + b, off, u, avol[u]);
-    }
+      if constexpr (kMM) Win::template add<u>(G.vol + b, off, avol[u]);
+    });
   }
 
   // Moves the block to window base b, writing out what it held before.
@@ -95,10 +96,11 @@ struct WindowBlock {
 
   void accumulate(const Win& win, const ScatterSource<D, Real>& q) {
     const V X = win.X(), GXl = win.GX();
-    for (int u = 0; u < U; ++u) {
-      const V Yu = win.Y(u);
+    static_for<U>([&](auto uc) {
+      constexpr int u = decltype(uc)::value;
+      const V Yu = win.template Y<u>();
       const V s = X * Yu;
-      const V Gx = GXl * Yu, Gy = X * win.GY(u);
+      const V Gx = GXl * Yu, Gy = X * win.template GY<u>();
       if constexpr (kMass) am[u] += s * q.m;
       if constexpr (kMom)
         for (int d = 0; d < D; ++d) ap[d][u] += s * q.mv[d];
@@ -108,7 +110,7 @@ struct WindowBlock {
           af[0][u] -= q.vs[0] * Gx + q.vs[2] * Gy;
           af[1][u] -= q.vs[2] * Gx + q.vs[1] * Gy;
         } else {
-          const V Gz = X * win.GZ(u);
+          const V Gz = X * win.template GZ<u>();
           af[0][u] -= q.vs[0] * Gx + q.vs[5] * Gy + q.vs[4] * Gz;
           af[1][u] -= q.vs[5] * Gx + q.vs[1] * Gy + q.vs[3] * Gz;
           af[2][u] -= q.vs[4] * Gx + q.vs[3] * Gy + q.vs[2] * Gz;
@@ -123,9 +125,9 @@ struct WindowBlock {
       if constexpr (kGrad) {
         ag[0][u] += Gx * q.area;
         ag[1][u] += Gy * q.area;
-        if constexpr (D == 3) ag[2][u] += (X * win.GZ(u)) * q.area;
+        if constexpr (D == 3) ag[2][u] += (X * win.template GZ<u>()) * q.area;
       }
-    }
+    });
   }
 };
 
