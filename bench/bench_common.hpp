@@ -47,6 +47,7 @@ void register_multimaterial();
 void register_sort();
 void register_step();
 void register_mm_scene();
+void register_scaling();
 
 // The whole-step two-layer scene (bench_step.cpp), shared with bench_mm_scene.cpp.
 Simulation& two_layer_interface_simulation();

@@ -28,6 +28,7 @@ int main(int argc, char** argv) {
   mmpm::bench::register_sort();
   mmpm::bench::register_step();
   mmpm::bench::register_mm_scene();
+  mmpm::bench::register_scaling();
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::AddCustomContext("omp_max_threads", std::to_string(omp_get_max_threads()));
