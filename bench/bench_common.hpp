@@ -49,6 +49,17 @@ void register_step();
 void register_mm_scene();
 void register_scaling();
 
+// The 2D linear one-material scene (bench_scaling.cpp): a square block of
+// `cells` x `cells` cells, 2 x 2 particles per cell, in a grid 4 cells wider.
+// bench_step.cpp's 2d_linear_1mat is linear_block_scene(250).
+std::string linear_block_scene(int cells);
+// Per-stage counters stage_<name>_ns_per_particle from two stage_seconds()
+// readings (bench_step.cpp); returns the per-stage seconds between them.
+std::array<double, 7> set_stage_counters(benchmark::State& state,
+                                         const std::array<double, 7>& before,
+                                         const std::array<double, 7>& after, double steps,
+                                         double particles);
+
 // The whole-step two-layer scene (bench_step.cpp), shared with bench_mm_scene.cpp.
 Simulation& two_layer_interface_simulation();
 Scheme two_layer_interface_scheme();
@@ -87,7 +98,9 @@ inline double& time_scale() {
   static double scale = 1.0;
   return scale;
 }
-inline double min_time(double seconds) { return seconds * time_scale(); }
+inline double min_time(double seconds) {
+  return seconds * time_scale();
+}
 
 // Minimum time of one registered benchmark. Each benchmark runs once per
 // process; bench/run runs the whole binary several times (passes, minutes
@@ -110,7 +123,9 @@ inline void keep(const T& value) {
 }
 
 // Thread count for the OpenMP kernels of one benchmark.
-inline void use_threads(int threads) { omp_set_num_threads(threads); }
+inline void use_threads(int threads) {
+  omp_set_num_threads(threads);
+}
 
 // ---------------------------------------------------------------- particles
 template <int D, class Real>
@@ -322,8 +337,9 @@ std::size_t p2g_colored(const ParticleView<D, Real>& P, const GridView<D, Real>&
       const std::uint32_t t = tiles[k];
       const std::size_t b = B.tile_begin[t], e = B.tile_begin[t + 1];
       const std::size_t r =
-          Windowed ? p2g_range<D, Shape, Real, What, MultiField, Traction>(P, G, opt, b, e)
-                   : p2g_range_pointwise<D, Shape, Real, What, MultiField, Traction>(P, G, opt, b, e);
+          Windowed
+              ? p2g_range<D, Shape, Real, What, MultiField, Traction>(P, G, opt, b, e)
+              : p2g_range_pointwise<D, Shape, Real, What, MultiField, Traction>(P, G, opt, b, e);
       if (r != e) bad = std::min(bad, r);
     }
   }
@@ -334,8 +350,9 @@ std::size_t p2g_colored(const ParticleView<D, Real>& P, const GridView<D, Real>&
 template <int D, class Shape, class Real, unsigned What, bool Windowed = true>
 std::size_t p2g_serial(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
                        const P2GOptions& opt) {
-  const std::size_t r = Windowed ? p2g_range<D, Shape, Real, What, false, false>(P, G, opt, 0, P.n)
-                                 : p2g_range_pointwise<D, Shape, Real, What, false, false>(P, G, opt, 0, P.n);
+  const std::size_t r =
+      Windowed ? p2g_range<D, Shape, Real, What, false, false>(P, G, opt, 0, P.n)
+               : p2g_range_pointwise<D, Shape, Real, What, false, false>(P, G, opt, 0, P.n);
   return r == P.n ? SIZE_MAX : r;
 }
 
@@ -398,8 +415,9 @@ inline constexpr int kP2GFlopsPerNode = 2 + 2 * D + D * 2 * D;
 
 // Particle bytes the scatter streams in (x, v, m, V, stress, lp for gimp).
 template <int D, class Shape, class Real>
-inline constexpr std::size_t kP2GParticleBytes =
-    sizeof(Real) * (2 * D + 2 + kStressComponents<D> + (std::is_same_v<Shape, GimpShape> ? D : 0));
+inline constexpr std::size_t kP2GParticleBytes = sizeof(Real) *
+                                                 (2 * D + 2 + kStressComponents<D> +
+                                                  (std::is_same_v<Shape, GimpShape> ? D : 0));
 
 // ---------------------------------------------------------------- fixture cache
 // Benchmarks of one family share their (large) fixture across the repeated

@@ -22,9 +22,13 @@ namespace mmpm::bench {
 namespace {
 
 // Cells per side of the block for n particles (2 x 2 per cell).
-int block_cells(double n) { return int(std::lround(std::sqrt(n / 4.0))); }
+int block_cells(double n) {
+  return int(std::lround(std::sqrt(n / 4.0)));
+}
 
-std::string scaling_scene(int cells) {
+}  // namespace
+
+std::string linear_block_scene(int cells) {
   const int grid = cells + 4;
   return R"(
 [simulation]
@@ -37,7 +41,8 @@ cfl       = 0.4
 [grid]
 origin = [0.0, 0.0]
 cell   = [1.0, 1.0]
-cells  = [)" + std::to_string(grid) + ", " + std::to_string(grid) + R"(]
+cells  = [)" +
+         std::to_string(grid) + ", " + std::to_string(grid) + R"(]
 shape  = "linear"
 
 [[material]]
@@ -52,7 +57,8 @@ name     = "block"
 material = "steel"
 shape    = "box"
 min      = [2.0, 2.0]
-max      = [)" + std::to_string(cells + 2) + ".0, " + std::to_string(cells + 2) + R"(.0]
+max      = [)" +
+         std::to_string(cells + 2) + ".0, " + std::to_string(cells + 2) + R"(.0]
 particles_per_cell = 2
 velocity = [0.5, 0.0]
 
@@ -62,13 +68,15 @@ fix   = ["x"]
 )";
 }
 
+namespace {
+
 Simulation& scaling_simulation(int cells) {
   static std::unique_ptr<Simulation> sim;
   static int sim_cells = -1;
   if (!sim || sim_cells != cells) {
     sim.reset();
     if (fixture_release()) fixture_release()();
-    sim = make_simulation(parse_scene_text(scaling_scene(cells), "scaling.toml"));
+    sim = make_simulation(parse_scene_text(linear_block_scene(cells), "scaling.toml"));
     sim_cells = cells;
     for (int k = 0; k < 2; ++k) sim->step();  // first sort, first touch
   }
@@ -90,11 +98,7 @@ void bm_scaling(benchmark::State& state, double target, int threads) {
     const double n = double(sim.particle_count());
     const double steps = double(state.iterations());
     set_ns_per_particle(state, n);
-    const char* names[kStageCount] = {"sort", "p2g", "mm", "grid", "g2p", "constitutive", "output"};
-    for (int s = 0; s < kStageCount; ++s) {
-      if (s == kStageOutput) continue;
-      state.counters[std::string("stage_") + names[s] + "_ns_per_particle"] = (s1[s] - s0[s]) * 1e9 / (steps * n);
-    }
+    set_stage_counters(state, s0, s1, steps, n);
     const double nodes = double(cells + 5) * double(cells + 5);
     state.counters["grid_MiB"] = nodes * 9 * 8 / 1048576.0;
     state.counters["particle_MiB"] = n * 20 * 8 / 1048576.0;
@@ -111,10 +115,10 @@ void register_scaling() {
     for (int threads : {1, 2}) {
       char label[32];
       std::snprintf(label, sizeof label, "%.0e", n);
-      const std::string name = std::string("scaling/particles:") + label + "/threads:" + std::to_string(threads);
-      auto* b = benchmark::RegisterBenchmark(name.c_str(), [n, threads](benchmark::State& st) {
-        bm_scaling(st, n, threads);
-      });
+      const std::string name =
+          std::string("scaling/particles:") + label + "/threads:" + std::to_string(threads);
+      auto* b = benchmark::RegisterBenchmark(
+          name.c_str(), [n, threads](benchmark::State& st) { bm_scaling(st, n, threads); });
       // Small sizes need many steps for a stable time; 10^7 needs a few.
       configure(b->UseRealTime()->Unit(benchmark::kMillisecond), n >= 3e6 ? 1.5 : 0.5);
     }

@@ -31,41 +31,6 @@
 namespace mmpm::bench {
 namespace {
 
-const char* kLinear2D = R"(
-[simulation]
-dimension = 2
-plane     = "strain"
-thickness = 1.0
-end_time  = 1.0
-cfl       = 0.4
-
-[grid]
-origin = [0.0, 0.0]
-cell   = [1.0, 1.0]
-cells  = [254, 254]
-shape  = "linear"
-
-[[material]]
-name    = "steel"
-type    = "isotropic"
-density = 7.8e-3
-E       = 200000.0
-nu      = 0.3
-
-[[body]]
-name     = "block"
-material = "steel"
-shape    = "box"
-min      = [2.0, 2.0]
-max      = [252.0, 252.0]
-particles_per_cell = 2
-velocity = [0.5, 0.0]
-
-[[boundary]]
-where = { x = 2.0 }
-fix   = ["x"]
-)";
-
 const char* kGimp3D = R"(
 [simulation]
 dimension = 3
@@ -206,14 +171,9 @@ void bm_step(benchmark::State& state, const StepCase& c, int threads) {
     const double n = double(sim.particle_count());
     const double steps = double(state.iterations());
     set_ns_per_particle(state, n);
+    const auto ds = set_stage_counters(state, s0, s1, steps, n);
     double staged = 0;
-    std::array<double, kStageCount> ds{};
-    for (int s = 0; s < kStageCount; ++s) ds[s] = s1[s] - s0[s], staged += ds[s];
-    const char* names[kStageCount] = {"sort", "p2g", "mm", "grid", "g2p", "constitutive", "output"};
-    for (int s = 0; s < kStageCount; ++s) {
-      if (s == kStageOutput) continue;
-      state.counters[std::string("stage_") + names[s] + "_ns_per_particle"] = ds[s] * 1e9 / (steps * n);
-    }
+    for (double x : ds) staged += x;
     state.counters["staged_ns_per_particle"] = staged * 1e9 / (steps * n);
     const StepCounters sc = sim.counters();
     state.counters["mm_nodes"] = double(sc.multimaterial_nodes);
@@ -240,13 +200,28 @@ void add(const StepCase& c, int threads) {
     name += "/" + o.substr(dot + 1, eq - dot - 1) + ":" + value;
   }
   name += "/threads:" + std::to_string(threads);
-  auto* b = benchmark::RegisterBenchmark(name.c_str(), [c, threads](benchmark::State& st) {
-    bm_step(st, c, threads);
-  });
+  auto* b = benchmark::RegisterBenchmark(
+      name.c_str(), [c, threads](benchmark::State& st) { bm_step(st, c, threads); });
   configure(b->UseRealTime()->Unit(benchmark::kMillisecond), 0.6);
 }
 
 }  // namespace
+
+std::array<double, 7> set_stage_counters(benchmark::State& state,
+                                         const std::array<double, 7>& before,
+                                         const std::array<double, 7>& after, double steps,
+                                         double particles) {
+  static_assert(kStageCount == 7);
+  const char* names[kStageCount] = {"sort", "p2g", "mm", "grid", "g2p", "constitutive", "output"};
+  std::array<double, kStageCount> ds{};
+  for (int s = 0; s < kStageCount; ++s) {
+    ds[s] = after[s] - before[s];
+    if (s != kStageOutput)
+      state.counters[std::string("stage_") + names[s] + "_ns_per_particle"] =
+          ds[s] * 1e9 / (steps * particles);
+  }
+  return ds;
+}
 
 Scheme two_layer_interface_scheme() {
   static const Scheme scheme =
@@ -260,14 +235,17 @@ Simulation& two_layer_interface_simulation() {
 }
 
 void register_step() {
-  const StepCase linear{"2d_linear_1mat", kLinear2D, {}};
-  const StepCase interface{"2d_gimp_interface", two_layer(true, true), {}};
+  const StepCase linear{"2d_linear_1mat", linear_block_scene(250), {}};
+  const StepCase interface {
+    "2d_gimp_interface", two_layer(true, true), {}
+  };
   const StepCase gimp3d{"3d_gimp_1mat", kGimp3D, {}};
   const StepCase one_mat{"2d_gimp_1mat", two_layer(false, false), {}};
   const StepCase shared{"2d_gimp_2mat_shared", two_layer(true, false), {}};
   for (int threads : {1, 2}) add(linear, threads);
   // The default scheme is MUSL (two transfers); USL is the single-transfer baseline.
-  for (int threads : {1, 2}) add({"2d_linear_1mat", kLinear2D, {"simulation.scheme=\"USL\""}}, threads);
+  for (int threads : {1, 2})
+    add({"2d_linear_1mat", linear_block_scene(250), {"simulation.scheme=\"USL\""}}, threads);
   for (int threads : {1, 2}) add(interface, threads);
   for (int threads : {1, 2}) add(gimp3d, threads);
   // The unused-feature pair, interleaved.
@@ -277,7 +255,10 @@ void register_step() {
   }
   for (int every : {1, 10, 100})
     for (int threads : {1, 2})
-      add({"2d_linear_1mat", kLinear2D, {"simulation.sort_every=" + std::to_string(every)}}, threads);
+      add({"2d_linear_1mat",
+           linear_block_scene(250),
+           {"simulation.sort_every=" + std::to_string(every)}},
+          threads);
 }
 
 }  // namespace mmpm::bench

@@ -587,6 +587,24 @@ TYPED_TEST(P2G, WindowedScatterReportsTheSameParticleOffTheGrid) {
 
 // G2P: the solver's windowed gather against the pointwise reference, on a
 // smooth random grid velocity field, all outputs (v, x, L).
+// Random grid velocities (U(-1, 1)) and velocity changes (0.1 U(-1, 1)).
+template <int D, class Real>
+struct RandomGridVelocity {
+  std::vector<std::vector<Real>> vel, dvel;
+  GridVelocity<D, Real> V;
+  RandomGridVelocity(std::size_t total, unsigned seed)
+      : vel(D, std::vector<Real>(total)), dvel(D, std::vector<Real>(total)) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> U(-1.0, 1.0);
+    for (int d = 0; d < D; ++d) {
+      for (std::size_t i = 0; i < total; ++i)
+        vel[d][i] = Real(U(rng)), dvel[d][i] = Real(0.1 * U(rng));
+      V.vel[d] = vel[d].data();
+      V.dvel[d] = dvel[d].data();
+    }
+  }
+};
+
 struct NoKeys {
   std::uint32_t tile(std::size_t) const { return 0; }
   std::uint32_t tile_of_key(std::uint32_t) const { return 0; }
@@ -596,18 +614,8 @@ template <int D, class Shape, class Real>
 void check_window_g2p(bool edges, unsigned seed) {
   const bool gimp = std::string(Shape::name) == "gimp";
   Grid<D, Real> g(grid_cells<D>(), 2);
-  const std::size_t total = g.G.nodes * 2;
-  std::vector<std::vector<Real>> vel(D, std::vector<Real>(total)),
-      dvel(D, std::vector<Real>(total));
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> U(-1.0, 1.0);
-  GridVelocity<D, Real> V;
-  for (int d = 0; d < D; ++d) {
-    for (std::size_t i = 0; i < total; ++i)
-      vel[d][i] = Real(U(rng)), dvel[d][i] = Real(0.1 * U(rng));
-    V.vel[d] = vel[d].data();
-    V.dvel[d] = dvel[d].data();
-  }
+  RandomGridVelocity<D, Real> gv(g.G.nodes * 2, seed);
+  const GridVelocity<D, Real>& V = gv.V;
   const std::size_t n = D == 2 ? 6000 : 4000;
   auto base = random_particles<D, Real>(g.G, g.cells, n, seed);
   if (edges) spread_to_edges<D, Shape, Real>(base, g.G, seed + 1);
@@ -663,18 +671,8 @@ template <int D, class Shape, class Real, bool Windowed>
 void check_fused_musl(unsigned seed) {
   const bool gimp = std::string(Shape::name) == "gimp";
   Grid<D, Real> fused(grid_cells<D>(), 2), separate(grid_cells<D>(), 2);
-  const std::size_t total = fused.G.nodes * 2;
-  std::vector<std::vector<Real>> vel(D, std::vector<Real>(total)),
-      dvel(D, std::vector<Real>(total));
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> U(-1.0, 1.0);
-  GridVelocity<D, Real> V;
-  for (int d = 0; d < D; ++d) {
-    for (std::size_t i = 0; i < total; ++i)
-      vel[d][i] = Real(U(rng)), dvel[d][i] = Real(0.1 * U(rng));
-    V.vel[d] = vel[d].data();
-    V.dvel[d] = dvel[d].data();
-  }
+  RandomGridVelocity<D, Real> gv(fused.G.nodes * 2, seed);
+  const GridVelocity<D, Real>& V = gv.V;
   const std::size_t n = D == 2 ? 6000 : 4000;
   auto a = random_particles<D, Real>(fused.G, fused.cells, n, seed);
   TileLayout<D> tiles;
