@@ -284,8 +284,12 @@ def kernel_section(R):
 
 STEP_SCENES = [
     ("2d_linear_1mat", "2D linear, 1 elastic material"),
-    (("2d_linear_1mat", "USL"), "the same with scheme = USL (one transfer)"),
+    (("2d_linear_1mat", {"scheme": "USL"}), "the same with scheme = USL (one transfer)"),
+    (("2d_linear_1mat", {"fuse_constitutive": "false"}),
+     "the same with the constitutive update as its own pass (unfused)"),
     ("2d_gimp_interface", "2D gimp two-layer, imperfect interface (Dn perfect, Dt 5, SN)"),
+    (("2d_gimp_interface", {"fuse_constitutive": "false"}),
+     "the same with the constitutive update as its own pass (unfused)"),
     ("3d_gimp_1mat", "3D gimp, 1 elastic material"),
     ("2d_gimp_1mat", "2D gimp, same geometry, 1 material (baseline)"),
     ("2d_gimp_2mat_shared", "2D gimp, 2 materials sharing one field"),
@@ -305,7 +309,7 @@ def step_section(R):
     for scene, label in STEP_SCENES:
         kw = {"scene": scene}
         if isinstance(scene, tuple):
-            kw = {"scene": scene[0], "scheme": scene[1]}
+            kw = {"scene": scene[0], **scene[1]}
             scene = scene[0]
         v1 = R.value("step", ns, threads=1, **kw)
         v2 = R.value("step", ns, threads=2, **kw)

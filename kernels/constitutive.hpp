@@ -55,13 +55,23 @@ inline Real volume_ratio(const ParticleView<D, Real>& P, std::size_t p, Real dt)
   }
 }
 
+// Per-particle updates: one functor per material type, applied to particle
+// p. The loop drivers below run them as a separate pass; the G2P gradient
+// pass runs them straight after L (kernels/g2p.hpp kStressUpdate), so L,
+// sigma and V are still in registers or L1 (docs/performance.md).
 template <int D, class Real>
-void isotropic_update(const ParticleView<D, Real>& P, const std::uint32_t* idx, std::size_t count,
-                      const ElasticKernelConstants& c, double dt_in) {
-  const Real dt = Real(dt_in), lam = Real(c.lambda), mu2 = Real(2 * c.mu);
-  const Real Ep = Real(c.Ep), nu = Real(c.nu);
-  const bool pstress = c.plane_stress;
-  for_particles(idx, count, [&](std::size_t p) {
+struct IsotropicPoint {
+  Real dt = 0, lam = 0, mu2 = 0, Ep = 0, nu = 0;
+  bool pstress = false;
+  IsotropicPoint() = default;
+  IsotropicPoint(const ElasticKernelConstants& c, double dt_in)
+      : dt(Real(dt_in)),
+        lam(Real(c.lambda)),
+        mu2(Real(2 * c.mu)),
+        Ep(Real(c.Ep)),
+        nu(Real(c.nu)),
+        pstress(c.plane_stress) {}
+  void operator()(const ParticleView<D, Real>& P, std::size_t p) const {
     if constexpr (D == 2) {
       const Real exx = dt * P.L[0][p], eyy = dt * P.L[3][p];
       const Real exy = Real(0.5) * dt * (P.L[1][p] + P.L[2][p]);
@@ -90,21 +100,23 @@ void isotropic_update(const ParticleView<D, Real>& P, const std::uint32_t* idx, 
       P.s[5][p] += Real(0.5) * mu2 * dt * (P.L[1][p] + P.L[3][p]);  // xy
       P.V[p] *= volume_ratio(P, p, dt);
     }
-  });
-}
+  }
+};
 
 template <int D, class Real>
-void anisotropic_update(const ParticleView<D, Real>& P, const std::uint32_t* idx, std::size_t count,
-                        const ElasticKernelConstants& c, double dt_in) {
-  const Real dt = Real(dt_in);
-  Real C2[4][3], Z[3], C3[6][6];
-  for (int i = 0; i < 4; ++i)
-    for (int j = 0; j < 3; ++j) C2[i][j] = Real(c.C2[i][j]);
-  for (int j = 0; j < 3; ++j) Z[j] = Real(c.zz_strain[j]);
-  for (int i = 0; i < 6; ++i)
-    for (int j = 0; j < 6; ++j) C3[i][j] = Real(c.C3[i][j]);
-  const bool pstress = c.plane_stress;
-  for_particles(idx, count, [&](std::size_t p) {
+struct AnisotropicPoint {
+  Real dt = 0, C2[4][3] = {}, Z[3] = {}, C3[6][6] = {};
+  bool pstress = false;
+  AnisotropicPoint() = default;
+  AnisotropicPoint(const ElasticKernelConstants& c, double dt_in)
+      : dt(Real(dt_in)), pstress(c.plane_stress) {
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 3; ++j) C2[i][j] = Real(c.C2[i][j]);
+    for (int j = 0; j < 3; ++j) Z[j] = Real(c.zz_strain[j]);
+    for (int i = 0; i < 6; ++i)
+      for (int j = 0; j < 6; ++j) C3[i][j] = Real(c.C3[i][j]);
+  }
+  void operator()(const ParticleView<D, Real>& P, std::size_t p) const {
     if constexpr (D == 2) {
       const Real e[3] = {dt * P.L[0][p], dt * P.L[3][p], dt * (P.L[1][p] + P.L[2][p])};
       for (int i = 0; i < 4; ++i) P.s[i][p] += C2[i][0] * e[0] + C2[i][1] * e[1] + C2[i][2] * e[2];
@@ -125,17 +137,18 @@ void anisotropic_update(const ParticleView<D, Real>& P, const std::uint32_t* idx
       }
       P.V[p] *= volume_ratio(P, p, dt);
     }
-  });
-}
+  }
+};
 
 // Compressible neo-Hookean: sigma = mu/J (B - I) + lambda ln(J)/J I,
 // F <- (I + dt L) F. Plane strain in 2D (F_zz = 1).
 template <int D, class Real>
-void neohookean_update(const ParticleView<D, Real>& P, const std::uint32_t* idx, std::size_t count,
-                       const ElasticKernelConstants& c, double dt_in) {
-  const Real dt = Real(dt_in), lam = Real(c.lambda), mu = Real(c.mu);
-  const Real inv_rho = Real(1 / c.density);
-  for_particles(idx, count, [&](std::size_t p) {
+struct NeoHookeanPoint {
+  Real dt = 0, lam = 0, mu = 0, inv_rho = 0;
+  NeoHookeanPoint() = default;
+  NeoHookeanPoint(const ElasticKernelConstants& c, double dt_in)
+      : dt(Real(dt_in)), lam(Real(c.lambda)), mu(Real(c.mu)), inv_rho(Real(1 / c.density)) {}
+  void operator()(const ParticleView<D, Real>& P, std::size_t p) const {
     Real A[D * D], F[D * D], Fn[D * D];
     for (int i = 0; i < D * D; ++i) {
       A[i] = dt * P.L[i][p] + ((i % (D + 1)) == 0 ? Real(1) : Real(0));
@@ -154,7 +167,7 @@ void neohookean_update(const ParticleView<D, Real>& P, const std::uint32_t* idx,
     else
       J = Fn[0] * (Fn[4] * Fn[8] - Fn[5] * Fn[7]) - Fn[1] * (Fn[3] * Fn[8] - Fn[5] * Fn[6]) +
           Fn[2] * (Fn[3] * Fn[7] - Fn[4] * Fn[6]);
-    // J <= 0 is caught by the stepper's finiteness check through log(J) = NaN.
+    // J <= 0 is caught by the finiteness check through log(J) = NaN.
     const Real lnJ = std::log(J), inv_J = Real(1) / J;
     Real B[D * D];
     for (int i = 0; i < D; ++i)
@@ -178,7 +191,72 @@ void neohookean_update(const ParticleView<D, Real>& P, const std::uint32_t* idx,
       P.s[5][p] = mu * inv_J * B[1];
     }
     P.V[p] = P.m[p] * inv_rho * J;
-  });
+  }
+};
+
+template <int D, class Real>
+void isotropic_update(const ParticleView<D, Real>& P, const std::uint32_t* idx, std::size_t count,
+                      const ElasticKernelConstants& c, double dt) {
+  const IsotropicPoint<D, Real> f(c, dt);
+  for_particles(idx, count, [&](std::size_t p) { f(P, p); });
 }
+
+template <int D, class Real>
+void anisotropic_update(const ParticleView<D, Real>& P, const std::uint32_t* idx, std::size_t count,
+                        const ElasticKernelConstants& c, double dt) {
+  const AnisotropicPoint<D, Real> f(c, dt);
+  for_particles(idx, count, [&](std::size_t p) { f(P, p); });
+}
+
+template <int D, class Real>
+void neohookean_update(const ParticleView<D, Real>& P, const std::uint32_t* idx, std::size_t count,
+                       const ElasticKernelConstants& c, double dt) {
+  const NeoHookeanPoint<D, Real> f(c, dt);
+  for_particles(idx, count, [&](std::size_t p) { f(P, p); });
+}
+
+// A stressed particle is sound when its volume is positive and finite and
+// its stress finite (an inverted or blown-up particle fails this).
+template <int D, class Real>
+inline bool particle_sound(const ParticleView<D, Real>& P, std::size_t p) {
+  return P.V[p] > Real(0) && std::isfinite(P.V[p]) && std::isfinite(P.s[0][p]);
+}
+
+// The fused update (kernels/g2p.hpp kStressUpdate) for scenes whose
+// stressed materials are all isotropic, the common case. The isotropic
+// update is a dozen multiply-adds with no calls; a per-particle switch
+// over every model (the neo-Hookean one calls log) made the fused 2D linear
+// step slower than two passes (docs/performance.md), so the other types
+// keep their own pass.
+template <int D, class Real>
+struct IsotropicStressUpdate {
+  struct Entry {
+    IsotropicPoint<D, Real> update;
+    bool stressed = false;  // false: rigid (no stress, no volume change)
+  };
+  const Entry* table = nullptr;  // per material
+  // One material: its constants held by value, so that a local copy of
+  // this functor keeps them in registers (stores to the particle arrays may
+  // alias a table in memory, which forces a reload per particle).
+  Entry only;
+  bool uniform = false;
+  IsotropicStressUpdate(const Entry* t, std::size_t materials)
+      : table(t), only(materials > 0 ? t[0] : Entry{}), uniform(materials == 1) {}
+  // Updates sigma and V of particle p from its L; false when the particle
+  // is no longer sound.
+  [[gnu::always_inline]] bool operator()(const ParticleView<D, Real>& P, std::size_t p) const {
+    const Entry& e = uniform ? only : table[P.mat[p]];
+    if (e.stressed) e.update(P, p);
+    return particle_sound(P, p);
+  }
+};
+
+// No stress update (G2P passes without kStressUpdate).
+struct NoStressUpdate {
+  template <class View>
+  bool operator()(const View&, std::size_t) const {
+    return true;
+  }
+};
 
 }  // namespace mmpm

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <type_traits>
 
+#include "kernels/constitutive.hpp"
 #include "kernels/grid_update.hpp"
 #include "kernels/weights.hpp"
 #include "kernels/window_block.hpp"
@@ -23,6 +24,9 @@ enum G2PWhat : unsigned {
   // the velocity-gradient pass moves x to x_next when it is done with x.
   kScatterMomentum = 4u,
   kCommitPosition = 8u,
+  // With kVelocityGradient: the constitutive update of each particle right
+  // after its L (the StressFn argument), instead of a pass of its own.
+  kStressUpdate = 16u,
 };
 
 struct G2PParams {
@@ -37,6 +41,7 @@ struct G2PParams {
 // non-finite velocity), work of external forces, particles that changed tile.
 struct G2PRangeResult {
   std::size_t bad = SIZE_MAX;
+  std::size_t unsound = SIZE_MAX;  // kStressUpdate: first particle with J <= 0 or non-finite stress
   double external_work = 0;
   bool moved_tile = false;
 };
@@ -145,10 +150,11 @@ struct G2PGather {
 };
 
 template <int D, class Shape, class Real, unsigned What, bool MultiField, bool Traction,
-          bool Gravity, bool Windowed, class KeyFn>
+          bool Gravity, bool Windowed, class KeyFn, class StressFn = NoStressUpdate>
 G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const GridView<D, Real>& grid,
                               const GridVelocity<D, Real>& velocities, const G2PParams& q,
-                              const KeyFn& key_of, std::size_t begin, std::size_t end) {
+                              const KeyFn& key_of, std::size_t begin, std::size_t end,
+                              const StressFn& stress = {}) {
   // Local copies of the views: the particle stores below cannot alias them,
   // so the array pointers stay in registers.
   const ParticleView<D, Real> P = particles;
@@ -157,7 +163,10 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
   G2PRangeResult r;
   const Real dt = Real(q.dt), flip = Real(q.flip), pic = Real(1) - Real(q.flip);
   G2PGather<D, Shape, Real, Windowed> st(G);
+  const StressFn S = stress;  // a local copy: its constants cannot alias the particle stores
   constexpr bool kScatter = (What & kScatterMomentum) != 0;
+  static_assert((What & kStressUpdate) == 0 || (What & kVelocityGradient) != 0,
+                "the stress update needs the velocity gradient");
   static_assert(!kScatter || (What & kUpdateMotion) != 0,
                 "the momentum scattered is the updated one");
   // The second transfer's block (windowed), or node-by-node adds (pointwise).
@@ -226,6 +235,8 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
     }
     if constexpr ((What & kVelocityGradient) != 0)
       for (int c = 0; c < D * D; ++c) P.L[c][p] = L[c];
+    if constexpr ((What & kStressUpdate) != 0)
+      if (!S(P, p) && r.unsound == SIZE_MAX) r.unsound = p;
     if constexpr ((What & kCommitPosition) != 0) {
       for (int d = 0; d < D; ++d) P.x[d][p] = P.x_next[d][p];
       if (key_of.tile(p) != key_of.tile_of_key(P.key[p])) r.moved_tile = true;
@@ -239,15 +250,15 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
 // shapes (bench: node by node beats the flat window's horizontal sums, also
 // with MUSL's momentum scatter fused in) and for grids too small for a window.
 template <int D, class Shape, class Real, unsigned What, bool MultiField, bool Traction,
-          bool Gravity, class KeyFn>
+          bool Gravity, class KeyFn, class StressFn = NoStressUpdate>
 G2PRangeResult g2p_range(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
                          const GridVelocity<D, Real>& V, const G2PParams& q, const KeyFn& key_of,
-                         std::size_t begin, std::size_t end) {
+                         std::size_t begin, std::size_t end, const StressFn& stress = {}) {
   if (!Window<D, Shape, Real>::flat && Window<D, Shape, Real>::fits(G))
     return g2p_range_impl<D, Shape, Real, What, MultiField, Traction, Gravity, true>(
-        P, G, V, q, key_of, begin, end);
+        P, G, V, q, key_of, begin, end, stress);
   return g2p_range_impl<D, Shape, Real, What, MultiField, Traction, Gravity, false>(
-      P, G, V, q, key_of, begin, end);
+      P, G, V, q, key_of, begin, end, stress);
 }
 
 // The reference gather, node by node (benchmark baseline).

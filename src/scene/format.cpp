@@ -115,6 +115,7 @@ void write_simulation(Writer& w, const Scene& s) {
   w.word("default_law", sim.default_law);
   w.boolean("force", sim.force);
   w.integer("sort_every", sim.sort_every);
+  w.boolean("fuse_constitutive", sim.fuse_constitutive);
 }
 
 void write_grid(Writer& w, const GridSpec& g, int dim) {

@@ -538,7 +538,7 @@ class SceneReader {
   // -------------------------------------------------------- [simulation]
   void read_simulation(const Table& t) {
     t.only({"name", "dimension", "plane", "thickness", "end_time", "cfl", "dt", "scheme", "flip",
-            "precision", "default_law", "force", "sort_every"});
+            "precision", "default_law", "force", "sort_every", "fuse_constitutive"});
     SimulationSpec& sim = scene_.simulation;
     const Field d = t.need("dimension");
     const long long dimension = d.integer();
@@ -573,6 +573,7 @@ class SceneReader {
     if (auto f = t.get("default_law")) sim.default_law = f->choice(kDefaultLawNames);
     if (auto f = t.get("force")) sim.force = f->boolean();
     if (auto f = t.get("sort_every")) sim.sort_every = f->int_at_least(0);
+    if (auto f = t.get("fuse_constitutive")) sim.fuse_constitutive = f->boolean();
     scene_.name = default_name_;
     if (auto f = t.get("name")) scene_.name = scene_name_value(*f);
   }

@@ -49,6 +49,10 @@ struct SimulationSpec {
   Law default_law = Law::stick;
   bool force = false;  // run even when dt exceeds the stability limit
   int sort_every = 0;  // 0 = re-bin only when a particle changes tile
+  // The constitutive update runs inside the G2P gradient pass (one particle
+  // pass fewer) when every stressed material is isotropic; false runs it as
+  // its own pass, timed as its own stage.
+  bool fuse_constitutive = true;
   Where step_where;    // where the time step was set (cfl or dt), for messages
 };
 

@@ -107,6 +107,11 @@ class Stepper final : public Simulation {
   G2PRangeResult g2p_range_of(const G2PParams& q, std::size_t begin, std::size_t end) const;
   void collect(const std::vector<G2PRangeResult>& results);
   void constitutive();
+  // The velocity-gradient G2P (What adds to kVelocityGradient) and the
+  // constitutive update: fused into one pass, or two passes and two stages.
+  template <unsigned What>
+  void gradient_and_stress();
+  void build_stress_table();
   void grid_update_stage();
   void finish_velocities(bool with_dvel);
   void apply_boundaries(bool with_dvel);
@@ -130,6 +135,8 @@ class Stepper final : public Simulation {
   std::array<double, 3> gravity_{0, 0, 0};
   bool has_gravity_ = false, has_traction_ = false;
   bool domain_gradient_ = false;  // some interaction's normal needs g (P-33)
+  bool fuse_constitutive_ = true;  // scene's choice and every stressed material isotropic
+  std::vector<typename IsotropicStressUpdate<D, Real>::Entry> stress_table_;  // per material
 
   ColumnSet<Real> pcols_, gcols_;
   std::vector<std::uint8_t> scratch_bytes_;
@@ -145,7 +152,7 @@ class Stepper final : public Simulation {
   std::array<std::vector<std::uint32_t>, 8> color_tiles_;  // non-empty tiles per color
   bool dirty_ = true;
 
-  // Per-material particle lists (only when several materials share the step).
+  // Per-material particle lists (several materials, constitutive pass unfused).
   std::vector<std::vector<std::uint32_t>> material_particles_;
   double traction_ramp_end_ = 0;  // tractions are constant after the last load ramp
 

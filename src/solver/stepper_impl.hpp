@@ -10,6 +10,8 @@ Stepper<D, Shape, Real>::Stepper(const Scene& scene) : scene_(scene), plan_(plan
   boundaries_ = resolve_boundaries(scene);
   boundary_reaction_.assign(boundaries_.size(), Vec3{0, 0, 0});
   dt_ = stable_time_step(scene);
+  fuse_constitutive_ = scene.simulation.fuse_constitutive;
+  build_stress_table();
   thickness_ = D == 2 ? Real(scene.simulation.thickness) : Real(1);
   for (const auto& l : scene.loads) {
     if (l.kind == LoadKind::gravity) {
@@ -142,8 +144,25 @@ void Stepper<D, Shape, Real>::setup_particles(const ParticleSeeds& seeds) {
                                    " is too close to the grid edge for the '" + Shape::name +
                                    "' shape function: enlarge the grid"));
   const std::size_t nm = materials_.size();
-  if (nm > 1) material_particles_.resize(nm);
+  if (nm > 1 && !fuse_constitutive_) material_particles_.resize(nm);
   dirty_ = true;
+}
+
+// The fused update's per-material table (the time step is fixed per run);
+// fusing needs every stressed material to be isotropic
+// (kernels/constitutive.hpp IsotropicStressUpdate).
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::build_stress_table() {
+  stress_table_.assign(materials_.size(), {});
+  for (std::size_t i = 0; i < materials_.size(); ++i) {
+    const MaterialModel& mat = materials_[i];
+    if (mat.type == MaterialType::isotropic) {
+      stress_table_[i].update = IsotropicPoint<D, Real>(mat.k, dt_);
+      stress_table_[i].stressed = true;
+    } else if (mat.type != MaterialType::rigid) {
+      fuse_constitutive_ = false;
+    }
+  }
 }
 
 template <int D, class Shape, class Real>
@@ -264,7 +283,12 @@ G2PRangeResult Stepper<D, Shape, Real>::g2p_range_of(const G2PParams& q, std::si
                                                      std::size_t e) const {
   const KeyFn key_of = key_fn();
   auto run = [&]<bool MF, bool TR, bool GR>() {
-    return g2p_range<D, Shape, Real, What, MF, TR, GR>(P_, G_, GV_, q, key_of, b, e);
+    if constexpr ((What & kStressUpdate) != 0)
+      return g2p_range<D, Shape, Real, What, MF, TR, GR>(
+          P_, G_, GV_, q, key_of, b, e,
+          IsotropicStressUpdate<D, Real>(stress_table_.data(), stress_table_.size()));
+    else
+      return g2p_range<D, Shape, Real, What, MF, TR, GR>(P_, G_, GV_, q, key_of, b, e);
   };
   if (plan_.multimaterial) {
     if (has_traction_)
@@ -287,6 +311,8 @@ void Stepper<D, Shape, Real>::collect(const std::vector<G2PRangeResult>& res) {
   for (const auto& r : res) {
     if (r.bad != SIZE_MAX)
       fail_particle("g2p", r.bad, "non-finite velocity or stencil off the grid");
+    if (r.unsound != SIZE_MAX)
+      fail_particle("constitutive", r.unsound, "J <= 0 or a non-finite stress/volume");
     external_work_ += r.external_work;
     if (r.moved_tile) dirty_ = true;
   }
@@ -345,6 +371,24 @@ void Stepper<D, Shape, Real>::constitutive() {
       case MaterialType::rigid:
         break;
     }
+  }
+}
+
+template <int D, class Shape, class Real>
+template <unsigned What>
+void Stepper<D, Shape, Real>::gradient_and_stress() {
+  if (fuse_constitutive_) {
+    tic();
+    g2p<What | kVelocityGradient | kStressUpdate>();
+    toc(kStageG2P);
+  } else {
+    tic();
+    g2p<What | kVelocityGradient>();
+    toc(kStageG2P);
+    tic();
+    constitutive();
+    check_volumes();
+    toc(kStageConstitutive);
   }
 }
 
@@ -496,13 +540,7 @@ void Stepper<D, Shape, Real>::step() {
     tic();
     finish_velocities(false);
     toc(kStageGrid);
-    tic();
-    g2p<kVelocityGradient>();
-    toc(kStageG2P);
-    tic();
-    constitutive();
-    check_volumes();
-    toc(kStageConstitutive);
+    gradient_and_stress<0>();
     tic();
     p2g<kForce>("p2g");
     toc(kStageP2G);
@@ -521,9 +559,7 @@ void Stepper<D, Shape, Real>::step() {
   toc(kStageGrid);
 
   if (scheme == Scheme::USL) {
-    tic();
-    g2p<kUpdateMotion | kVelocityGradient>();
-    toc(kStageG2P);
+    gradient_and_stress<kUpdateMotion>();
   } else if (scheme == Scheme::USF) {
     tic();
     g2p<kUpdateMotion>();
@@ -550,16 +586,8 @@ void Stepper<D, Shape, Real>::step() {
     tic();
     finish_velocities(false);
     toc(kStageGrid);
-    tic();
-    g2p<kVelocityGradient | kCommitPosition>();
+    gradient_and_stress<kCommitPosition>();
     for (int d = 0; d < D; ++d) P_.x_next[d] = nullptr;
-    toc(kStageG2P);
-  }
-  if (scheme != Scheme::USF) {
-    tic();
-    constitutive();
-    check_volumes();
-    toc(kStageConstitutive);
   }
   time_ += dt_;
   ++step_;

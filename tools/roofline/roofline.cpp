@@ -86,7 +86,7 @@ struct Case {
 std::string block_scene(const Case& c) {
   const bool d3 = c.dim == 3;
   std::string s = "[simulation]\ndimension = " + std::to_string(c.dim) +
-                  "\nend_time = 1.0\ncfl = 0.5\nscheme = \"USL\"\nprecision = \"" + c.precision + "\"\n";
+                  "\nend_time = 1.0\ncfl = 0.5\nscheme = \"USL\"\nfuse_constitutive = false\nprecision = \"" + c.precision + "\"\n";
   s += d3 ? "[grid]\norigin = [-2.0, -2.0, -2.0]\ncell = [1.0, 1.0, 1.0]\ncells = [54, 54, 54]\n"
           : "[grid]\norigin = [-2.0, -2.0]\ncell = [1.0, 1.0]\ncells = [254, 254]\n";
   s += std::string("shape = \"") + c.shape + "\"\n";
