@@ -1,5 +1,6 @@
 // The constitutive update fused into the G2P gradient pass ([simulation]
-// fuse_constitutive = true; kernels/g2p.hpp kStressUpdate) computes what the
+// fuse_constitutive = true, not the default; kernels/g2p.hpp kStressUpdate)
+// computes what the
 // separate constitutive pass computes. Fusing applies only when every
 // stressed material is isotropic (kernels/constitutive.hpp
 // IsotropicStressUpdate); other scenes fall back to the separate pass.

@@ -49,11 +49,12 @@ struct SimulationSpec {
   Law default_law = Law::stick;
   bool force = false;  // run even when dt exceeds the stability limit
   int sort_every = 0;  // 0 = re-bin only when a particle changes tile
-  // The constitutive update runs inside the G2P gradient pass (one particle
-  // pass fewer) when every stressed material is isotropic; false runs it as
-  // its own pass, timed as its own stage.
-  bool fuse_constitutive = true;
-  Where step_where;    // where the time step was set (cfl or dt), for messages
+  // true: the constitutive update runs inside the G2P gradient pass (one
+  // particle pass fewer) when every stressed material is isotropic. Off by
+  // default: measured slower for 2D linear and no faster for 2D uGIMP
+  // (docs/performance.md, "Fusing the constitutive update").
+  bool fuse_constitutive = false;
+  Where step_where;  // where the time step was set (cfl or dt), for messages
 };
 
 struct GridSpec {
@@ -75,10 +76,10 @@ struct MaterialSpec {
   std::string name;
   MaterialType type = MaterialType::isotropic;
   double density = 1.0;
-  double E = 0, nu = 0;                        // isotropic, neohookean
+  double E = 0, nu = 0;                             // isotropic, neohookean
   double EA = 0, ET = 0, GA = 0, nuA = 0, nuT = 0;  // transverse
-  Vec3 axis{0, 1, 0};                          // transverse: the A (fibre) axis
-  VelocityTable velocity;                      // rigid (one row = constant)
+  Vec3 axis{0, 1, 0};                               // transverse: the A (fibre) axis
+  VelocityTable velocity;                           // rigid (one row = constant)
   Where where;
 };
 
@@ -86,14 +87,15 @@ struct BodySpec {
   std::string name;
   std::string material;
   BodyShape shape = BodyShape::box;
-  Vec3 min{0, 0, 0}, max{0, 0, 0};   // box
+  Vec3 min{0, 0, 0}, max{0, 0, 0};  // box
   double rotate = 0.0;              // degrees about the body's centre (2D)
-  std::optional<Vec3> pivot;        // rotate about this point instead (a whole specimen of several bodies)
-  Vec3 center{0, 0, 0};             // disk, sphere, cylinder
+  std::optional<Vec3>
+      pivot;             // rotate about this point instead (a whole specimen of several bodies)
+  Vec3 center{0, 0, 0};  // disk, sphere, cylinder
   double radius = 0.0;
-  double length = 0.0;              // cylinder (3D): along axis z from center
-  std::vector<Vec3> points;         // polygon
-  int particles_per_cell = 2;       // per direction
+  double length = 0.0;         // cylinder (3D): along axis z from center
+  std::vector<Vec3> points;    // polygon
+  int particles_per_cell = 2;  // per direction
   Vec3 velocity{0, 0, 0};
   std::optional<std::pair<Vec3, Vec3>> clip;  // fill only inside this box
   Where where;
@@ -120,9 +122,9 @@ enum class BoundaryWhere { face, plane, box };
 
 struct BoundarySpec {
   BoundaryWhere kind = BoundaryWhere::face;
-  int face_axis = 0;       // face: 0,1,2
-  bool face_max = false;   // face: min or max side
-  int plane_axis = 0;      // plane: { x = value }
+  int face_axis = 0;      // face: 0,1,2
+  bool face_max = false;  // face: min or max side
+  int plane_axis = 0;     // plane: { x = value }
   double plane_value = 0;
   Vec3 box_min{0, 0, 0}, box_max{0, 0, 0};
   std::array<bool, 3> fix{false, false, false};
@@ -147,9 +149,9 @@ struct LoadSpec {
 struct OutputSpec {
   double every = 0.0;  // time between particle snapshots; 0 = only the last
   std::vector<std::string> fields{"displacement", "velocity", "stress", "material"};
-  int series = 100;              // steps between series rows
-  double checkpoint_minutes = 0; // wall minutes between checkpoints; 0 = none
-  std::string directory;         // default results/<scene name>
+  int series = 100;               // steps between series rows
+  double checkpoint_minutes = 0;  // wall minutes between checkpoints; 0 = none
+  std::string directory;          // default results/<scene name>
 };
 
 struct StopSpec {
@@ -159,9 +161,9 @@ struct StopSpec {
 };
 
 struct Scene {
-  std::string name;        // from the file name (stem) unless [simulation] name
+  std::string name;  // from the file name (stem) unless [simulation] name
   std::string source_file;
-  std::string source_text; // resolved TOML (after --set), stored with results
+  std::string source_text;  // resolved TOML (after --set), stored with results
   SimulationSpec simulation;
   GridSpec grid;
   std::vector<MaterialSpec> materials;

@@ -135,7 +135,7 @@ class Stepper final : public Simulation {
   std::array<double, 3> gravity_{0, 0, 0};
   bool has_gravity_ = false, has_traction_ = false;
   bool domain_gradient_ = false;  // some interaction's normal needs g (P-33)
-  bool fuse_constitutive_ = true;  // scene's choice and every stressed material isotropic
+  bool fuse_constitutive_ = false;  // scene's choice and every stressed material isotropic
   std::vector<typename IsotropicStressUpdate<D, Real>::Entry> stress_table_;  // per material
 
   ColumnSet<Real> pcols_, gcols_;

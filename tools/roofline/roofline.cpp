@@ -29,7 +29,9 @@
 namespace {
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
 
 double triad_bandwidth(int threads) {
   const std::size_t n = std::size_t(1) << 24;
@@ -85,13 +87,16 @@ struct Case {
 
 std::string block_scene(const Case& c) {
   const bool d3 = c.dim == 3;
-  std::string s = "[simulation]\ndimension = " + std::to_string(c.dim) +
-                  "\nend_time = 1.0\ncfl = 0.5\nscheme = \"USL\"\nfuse_constitutive = false\nprecision = \"" + c.precision + "\"\n";
+  std::string s =
+      "[simulation]\ndimension = " + std::to_string(c.dim) +
+      "\nend_time = 1.0\ncfl = 0.5\nscheme = \"USL\"\nfuse_constitutive = false\nprecision = \"" +
+      c.precision + "\"\n";
   s += d3 ? "[grid]\norigin = [-2.0, -2.0, -2.0]\ncell = [1.0, 1.0, 1.0]\ncells = [54, 54, 54]\n"
           : "[grid]\norigin = [-2.0, -2.0]\ncell = [1.0, 1.0]\ncells = [254, 254]\n";
   s += std::string("shape = \"") + c.shape + "\"\n";
   s += "[[material]]\nname = \"m\"\ntype = \"isotropic\"\ndensity = 1.0e-3\nE = 1000.0\nnu = 0.3\n";
-  s += d3 ? "[[body]]\nmaterial = \"m\"\nshape = \"box\"\nmin = [0.0, 0.0, 0.0]\nmax = [50.0, 50.0, 50.0]\n"
+  s += d3 ? "[[body]]\nmaterial = \"m\"\nshape = \"box\"\nmin = [0.0, 0.0, 0.0]\nmax = [50.0, "
+            "50.0, 50.0]\n"
           : "[[body]]\nmaterial = \"m\"\nshape = \"box\"\nmin = [0.0, 0.0]\nmax = [250.0, 250.0]\n";
   s += "particles_per_cell = 2\n";
   s += d3 ? "velocity = [0.1, 0.05, 0.0]\n" : "velocity = [0.1, 0.05]\n";
@@ -107,12 +112,14 @@ int main(int argc, char** argv) {
     if (!std::strcmp(argv[i], "--steps")) steps = std::atoi(argv[i + 1]);
   }
   const double bw = triad_bandwidth(threads), peak = peak_gflops(threads);
-  std::printf("machine (%d thread%s): triad %.1f GB/s, peak FMA %.1f GFLOP/s (double, 8 lanes)\n\n", threads,
-              threads > 1 ? "s" : "", bw, peak);
-  std::printf("%-22s %-13s %9s %9s %9s %8s %8s %9s %7s\n", "case", "stage", "ns/part", "B/part", "flop/part",
-              "GB/s", "GFLOP/s", "bound ns", "x bound");
-  const Case cases[] = {{"2D linear double", 2, "linear", "double", 2}, {"2D gimp double", 2, "gimp", "double", 3},
-                        {"2D gimp float", 2, "gimp", "float", 3},      {"3D gimp double", 3, "gimp", "double", 3}};
+  std::printf("machine (%d thread%s): triad %.1f GB/s, peak FMA %.1f GFLOP/s (double, 8 lanes)\n\n",
+              threads, threads > 1 ? "s" : "", bw, peak);
+  std::printf("%-22s %-13s %9s %9s %9s %8s %8s %9s %7s\n", "case", "stage", "ns/part", "B/part",
+              "flop/part", "GB/s", "GFLOP/s", "bound ns", "x bound");
+  const Case cases[] = {{"2D linear double", 2, "linear", "double", 2},
+                        {"2D gimp double", 2, "gimp", "double", 3},
+                        {"2D gimp float", 2, "gimp", "float", 3},
+                        {"3D gimp double", 3, "gimp", "double", 3}};
   for (const Case& c : cases) {
     mmpm::Scene scene;
     try {
@@ -140,7 +147,8 @@ int main(int argc, char** argv) {
     // Compulsory traffic per particle (docs/performance.md).
     const double grid_per_p = nn / np * R * 2.0;  // one array read + written once per step
     const double p2g_bytes = R * (2 * D + 2 + NS + (gimp ? D : 0)) + grid_per_p * (1 + 2 * D);
-    const double g2p_bytes = R * (2 * D + (gimp ? D : 0)) + 4 + R * (2 * D + D * D) + grid_per_p / 2 * (2 * D);
+    const double g2p_bytes =
+        R * (2 * D + (gimp ? D : 0)) + 4 + R * (2 * D + D * D) + grid_per_p / 2 * (2 * D);
     const double con_bytes = R * (D * D + NS + 1) + R * (NS + 1);
     const double stencil_flops = D * (c.S == 2 ? 4.0 : 14.0) + nodes * (D + 1.0);
     const double p2g_flops = stencil_flops + 2 * D + NS + nodes * (2.0 + 2 * D + 4.0 * D);
@@ -157,8 +165,8 @@ int main(int argc, char** argv) {
     for (const Row& r : rows) {
       const double t = (after[r.idx] - before[r.idx]) / steps / np * 1e9;  // ns per particle
       const double bound = std::max(r.bytes / bw, r.flops / peak_real);  // ns (bytes / (GB/s) = ns)
-      std::printf("%-22s %-13s %9.2f %9.0f %9.0f %8.2f %8.2f %9.2f %7.2f\n", c.label, r.stage, t, r.bytes,
-                  r.flops, r.bytes / t, r.flops / t, bound, t / bound);
+      std::printf("%-22s %-13s %9.2f %9.0f %9.0f %8.2f %8.2f %9.2f %7.2f\n", c.label, r.stage, t,
+                  r.bytes, r.flops, r.bytes / t, r.flops / t, bound, t / bound);
     }
   }
   return 0;
