@@ -194,6 +194,18 @@ struct NeoHookeanPoint {
   }
 };
 
+// Entries [first, last) of a particle list (idx) or, without a list,
+// particles [first, last), on the calling thread.
+template <int D, class Real, class Update>
+inline void update_particles(const ParticleView<D, Real>& P, const std::uint32_t* idx,
+                             std::size_t first, std::size_t last, const Update& f) {
+  if (idx) {
+    for (std::size_t k = first; k < last; ++k) f(P, std::size_t(idx[k]));
+  } else {
+    for (std::size_t k = first; k < last; ++k) f(P, k);
+  }
+}
+
 template <int D, class Real>
 void isotropic_update(const ParticleView<D, Real>& P, const std::uint32_t* idx, std::size_t count,
                       const ElasticKernelConstants& c, double dt) {

@@ -94,6 +94,7 @@ class Stepper final : public Simulation {
   }
   void sort_particles();
   void rebuild_ranges();
+  std::pair<std::size_t, std::size_t> color_share(std::size_t color) const;
   void zero_grid(bool mm);
   template <unsigned What>
   void p2g(const char* stage_label);
@@ -134,7 +135,7 @@ class Stepper final : public Simulation {
   Real mass_threshold_ = 0;
   std::array<double, 3> gravity_{0, 0, 0};
   bool has_gravity_ = false, has_traction_ = false;
-  bool domain_gradient_ = false;  // some interaction's normal needs g (P-33)
+  bool domain_gradient_ = false;    // some interaction's normal needs g (P-33)
   bool fuse_constitutive_ = false;  // scene's choice and every stressed material isotropic
   std::vector<typename IsotropicStressUpdate<D, Real>::Entry> stress_table_;  // per material
 
@@ -150,6 +151,8 @@ class Stepper final : public Simulation {
   TileLayout<D> tiles_;
   std::vector<std::uint32_t> tile_begin_;                  // per tile, size tile_count + 1
   std::array<std::vector<std::uint32_t>, 8> color_tiles_;  // non-empty tiles per color
+  // Per color: particles in the color's tiles [0, k), size tiles + 1.
+  std::array<std::vector<std::uint32_t>, 8> color_prefix_;
   bool dirty_ = true;
 
   // Per-material particle lists (several materials, constitutive pass unfused).
