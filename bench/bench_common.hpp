@@ -265,8 +265,8 @@ struct GridSet {
 template <int D, class Real>
 struct Binning {
   TileLayout<D> tiles;
-  std::vector<std::uint32_t> offsets, perm, tile_begin;
-  std::array<std::vector<std::uint32_t>, 8> color_tiles;
+  std::vector<std::uint32_t> offsets, perm;
+  TileSchedule schedule;
   std::vector<Real> scratch;
   std::vector<std::uint8_t> scratch_bytes;
   std::vector<std::uint32_t> scratch_keys;
@@ -304,14 +304,7 @@ struct Binning {
     std::memcpy(S.P.key, scratch_keys.data(), n * sizeof(std::uint32_t));
   }
   void rebuild_ranges(const ParticleSet<D, Real>& S) {
-    const std::size_t n = S.P.n;
-    const std::uint32_t nt = tiles.tile_count;
-    tile_begin.assign(std::size_t(nt) + 1, 0);
-    for (std::size_t p = 0; p < n; ++p) ++tile_begin[tiles.tile_of_key(S.P.key[p]) + 1];
-    for (std::uint32_t t = 0; t < nt; ++t) tile_begin[t + 1] += tile_begin[t];
-    for (auto& c : color_tiles) c.clear();
-    for (std::uint32_t t = 0; t < nt; ++t)
-      if (tile_begin[t + 1] > tile_begin[t]) color_tiles[std::size_t(tiles.color(t))].push_back(t);
+    schedule.build(tiles, S.P.key, S.P.n);
   }
   void sort(ParticleSet<D, Real>& S, const GridView<D, Real>& G) {
     compute_keys(S, G);
@@ -330,12 +323,15 @@ template <int D, class Shape, class Real, unsigned What, bool MultiField, bool T
 std::size_t p2g_colored(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
                         const P2GOptions& opt, const Binning<D, Real>& B) {
   std::size_t bad = SIZE_MAX;
-  for (const auto& tiles : B.color_tiles) {
-    const std::size_t nt = tiles.size();
-#pragma omp parallel for schedule(dynamic, 1) reduction(min : bad) if (P.n >= kParallelMin)
-    for (std::size_t k = 0; k < nt; ++k) {
-      const std::uint32_t t = tiles[k];
-      const std::size_t b = B.tile_begin[t], e = B.tile_begin[t + 1];
+  const TileSchedule& S = B.schedule;
+  for (std::size_t c = 0; c < S.tiles.size(); ++c) {
+    if (S.tiles[c].empty()) continue;
+#pragma omp parallel reduction(min : bad) if (P.n >= kParallelMin)
+    for (auto [k, last] =
+             S.share(c, std::size_t(omp_get_num_threads()), std::size_t(omp_get_thread_num()));
+         k < last; ++k) {
+      const std::uint32_t t = S.tiles[c][k];
+      const std::size_t b = S.begin[t], e = S.begin[t + 1];
       const std::size_t r =
           Windowed
               ? p2g_range<D, Shape, Real, What, MultiField, Traction>(P, G, opt, b, e)

@@ -89,7 +89,7 @@ void bm_sort(benchmark::State& state, bool shuffled, int threads) {
     const auto t3 = Clock::now();
     fx.bins.rebuild_ranges(fx.S);
     const auto t4 = Clock::now();
-    keep(fx.bins.tile_begin.data());
+    keep(fx.bins.schedule.begin.data());
     benchmark::ClobberMemory();
     t_keys += std::chrono::duration<double>(t1 - t0).count();
     t_count += std::chrono::duration<double>(t2 - t1).count();
@@ -119,12 +119,12 @@ template <int D, class Real>
 void register_case() {
   for (bool shuffled : {false, true})
     for (int threads : {1, 2}) {
-      const std::string name = "sort/dim:" + std::to_string(D) + "/shape:gimp/real:" +
-                               real_name<Real>() + "/order:" + (shuffled ? "random" : "sorted") +
-                               "/threads:" + std::to_string(threads);
-      auto* b = benchmark::RegisterBenchmark(name.c_str(), [shuffled, threads](benchmark::State& st) {
-        bm_sort<D, Real>(st, shuffled, threads);
-      });
+      const std::string name =
+          "sort/dim:" + std::to_string(D) + "/shape:gimp/real:" + real_name<Real>() +
+          "/order:" + (shuffled ? "random" : "sorted") + "/threads:" + std::to_string(threads);
+      auto* b = benchmark::RegisterBenchmark(
+          name.c_str(),
+          [shuffled, threads](benchmark::State& st) { bm_sort<D, Real>(st, shuffled, threads); });
       configure(b->UseManualTime()->Unit(benchmark::kMillisecond), 0.1);
     }
 }

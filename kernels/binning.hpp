@@ -8,10 +8,12 @@
 // T >= 3 keeps same-colored tiles on disjoint nodes.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "kernels/reduce.hpp"
@@ -71,6 +73,58 @@ struct TileLayout {
       tile /= std::uint32_t(tiles[d]);
     }
     return col;
+  }
+};
+
+// Where the particles of each tile are, and which tiles each thread takes in
+// a colored pass (colors in turn, the tiles of one color in parallel).
+//
+// Thread i of T takes the tiles holding the i-th T-quantile of the color's
+// particles, in tile order, rather than tiles handed out dynamically.
+// Particles are stored tile by tile, so thread i then works on (nearly) the
+// same particles in every colored pass as in the static particle loops
+// (schedule(static): the i-th contiguous block of particles), and a
+// particle's cache lines stay in one core's caches from pass to pass. A
+// dynamic tile schedule moved them between the cores in every pass: the 2D
+// linear step on 2 threads took 29 ns/particle with it and 20 with this
+// split (docs/performance.md, "Threads keep their particles"). Which thread
+// runs a tile does not change what the tile computes, so the split leaves
+// the results bitwise unchanged.
+struct TileSchedule {
+  std::vector<std::uint32_t> begin;                  // first particle per tile, size tiles + 1
+  std::array<std::vector<std::uint32_t>, 8> tiles;   // non-empty tiles per color, in order
+  std::array<std::vector<std::uint32_t>, 8> prefix;  // per color: particles in tiles [0, k)
+
+  // From the sorted keys of n particles.
+  template <int D>
+  void build(const TileLayout<D>& layout, const std::uint32_t* key, std::size_t n) {
+    const std::uint32_t nt = layout.tile_count;
+    begin.assign(std::size_t(nt) + 1, 0);
+    for (std::size_t p = 0; p < n; ++p) ++begin[layout.tile_of_key(key[p]) + 1];
+    for (std::uint32_t t = 0; t < nt; ++t) begin[t + 1] += begin[t];
+    for (auto& c : tiles) c.clear();
+    for (std::uint32_t t = 0; t < nt; ++t)
+      if (begin[t + 1] > begin[t]) tiles[std::size_t(layout.color(t))].push_back(t);
+    for (std::size_t c = 0; c < tiles.size(); ++c) {
+      prefix[c].assign(tiles[c].size() + 1, 0);
+      for (std::size_t k = 0; k < tiles[c].size(); ++k)
+        prefix[c][k + 1] = prefix[c][k] + (begin[tiles[c][k] + 1] - begin[tiles[c][k]]);
+    }
+  }
+
+  // The positions [first, last) in tiles[color] that thread i of `threads`
+  // takes; the shares of all threads partition the color's tiles.
+  std::pair<std::size_t, std::size_t> share(std::size_t color, std::size_t threads,
+                                            std::size_t i) const {
+    const auto& pre = prefix[color];
+    const std::size_t count = pre.size() - 1, total = pre.back();
+    const auto boundary = [&](std::size_t j) -> std::size_t {
+      if (j == 0) return 0;
+      if (j >= threads) return count;
+      return std::size_t(std::lower_bound(pre.begin(), pre.end(), total * j / threads) -
+                         pre.begin());
+    };
+    return {boundary(i), boundary(i + 1)};
   }
 };
 

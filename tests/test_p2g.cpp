@@ -10,7 +10,7 @@
 //    to the sum of magnitudes, 1e-12 in double, 2e-5 in float.
 //  - The colored tile scatter as the solver runs it (counting_sort by the
 //    TileLayout key, colors in order, the tiles of one color in parallel on 2
-//    threads, schedule(dynamic)) is bitwise equal to the same scatter on 1
+//    threads, each thread its TileSchedule share) is bitwise equal to the same scatter on 1
 //    thread and to a plain serial loop of p2g_range over the tiles in color
 //    order. It equals a serial p2g_range over all particles in sorted order
 //    and one in the original (unsorted) order to 1e-12 relative (double;
@@ -214,37 +214,22 @@ std::vector<std::uint32_t> sort_by_tile(Particles<D, Real>& p, const GridView<D,
   return perm;
 }
 
-struct TileRanges {
-  std::vector<std::uint32_t> begin;                 // per tile, tile_count + 1
-  std::array<std::vector<std::uint32_t>, 8> color;  // non-empty tiles per color
-};
-
-template <int D>
-TileRanges tile_ranges(const std::vector<std::uint32_t>& sorted_keys, const TileLayout<D>& tiles) {
-  TileRanges r;
-  r.begin.assign(std::size_t(tiles.tile_count) + 1, 0);
-  for (std::uint32_t k : sorted_keys) ++r.begin[tiles.tile_of_key(k) + 1];
-  for (std::uint32_t t = 0; t < tiles.tile_count; ++t) r.begin[t + 1] += r.begin[t];
-  for (std::uint32_t t = 0; t < tiles.tile_count; ++t)
-    if (r.begin[t + 1] > r.begin[t]) r.color[std::size_t(tiles.color(t))].push_back(t);
-  return r;
-}
-
 // The colored scatter (as Stepper::p2g runs it), with `threads` OpenMP threads.
 // Returns the number of threads the parallel regions actually had.
 template <int D, class Shape, class Real, unsigned What, bool MF, bool TR>
 int colored_p2g(const ParticleView<D, Real>& P, const GridView<D, Real>& G, const P2GOptions& opt,
-                const TileRanges& r, int threads) {
+                const TileSchedule& r, int threads) {
   int team = 0;
   std::size_t bad = SIZE_MAX;
-  for (const auto& list : r.color) {
-    const std::size_t nt = list.size();
+  for (std::size_t c = 0; c < r.tiles.size(); ++c) {
+    const auto& list = r.tiles[c];
 #pragma omp parallel num_threads(threads) reduction(min : bad)
     {
 #pragma omp single
       team = std::max(team, omp_get_num_threads());
-#pragma omp for schedule(dynamic, 1)
-      for (std::size_t k = 0; k < nt; ++k) {
+      const auto [first, last] =
+          r.share(c, std::size_t(omp_get_num_threads()), std::size_t(omp_get_thread_num()));
+      for (std::size_t k = first; k < last; ++k) {
         const std::uint32_t t = list[k];
         const std::size_t b = r.begin[t], e = r.begin[t + 1];
         const std::size_t got = p2g_range<D, Shape, Real, What, MF, TR>(P, G, opt, b, e);
@@ -426,13 +411,14 @@ void check_colored(int T, unsigned seed) {
   for (std::size_t i = 1; i < n; ++i)
     ASSERT_LE(sorted.key[i - 1], sorted.key[i]) << "sorted by key";
   const auto P = sorted.view(gimp);
-  const TileRanges r = tile_ranges<D>(sorted.key, tiles);
+  TileSchedule r;
+  r.build(tiles, sorted.key.data(), n);
   int colors_used = 0;
-  for (const auto& c : r.color) colors_used += !c.empty();
+  for (const auto& c : r.tiles) colors_used += !c.empty();
   ASSERT_EQ(colors_used, 1 << D) << "every color has tiles";
 
   ASSERT_EQ((p2g_range<D, Shape, Real, What, MF, TR>(P, sorted_serial.G, opt, 0, n)), n);
-  for (const auto& list : r.color)  // serial twin of the colored scatter, no OpenMP
+  for (const auto& list : r.tiles)  // serial twin of the colored scatter, no OpenMP
     for (std::uint32_t t : list)
       ASSERT_EQ(
           (p2g_range<D, Shape, Real, What, MF, TR>(P, serial.G, opt, r.begin[t], r.begin[t + 1])),
@@ -730,6 +716,53 @@ TYPED_TEST(P2G, FusedMuslTransferMatchesSeparatePassesWindowed) {
 }
 TYPED_TEST(P2G, FusedMuslTransferMatchesSeparatePassesPointwise) {
   check_fused_musl<TypeParam::D, typename TypeParam::Shape, typename TypeParam::Real, false>(602);
+}
+
+// TileSchedule::share: for 1 to 4 threads, the threads' shares of every
+// color are contiguous, disjoint and cover the color's tiles in order, and
+// each thread's particle count is within one tile's count of the color's
+// particles / threads (the split is by particle quantiles). 2D grid 37 x 29
+// cells, tile edge 4, 6000 random particles (non-uniform: two thirds of
+// them in the left quarter of the grid, so equal tile counts would not
+// balance).
+TEST(TileSchedule, SharesPartitionEachColorByParticleQuantiles) {
+  Grid<2, double> g(grid_cells<2>(), 1);
+  auto p = random_particles<2, double>(g.G, g.cells, 6000, 77);
+  for (std::size_t i = 0; i < p.n; i += 3)
+    p.x[0][i] = g.G.origin[0] + 0.25 * (p.x[0][i] - g.G.origin[0]);
+  for (std::size_t i = 1; i < p.n; i += 3)
+    p.x[0][i] = g.G.origin[0] + 0.25 * (p.x[0][i] - g.G.origin[0]);
+  TileLayout<2> tiles;
+  tiles.setup(4, g.cells);
+  auto sorted = p.permuted(sort_by_tile(p, g.G, tiles));
+  TileSchedule r;
+  r.build(tiles, sorted.key.data(), sorted.n);
+  ASSERT_EQ(r.begin.back(), sorted.n);
+  for (std::size_t c = 0; c < 4; ++c) {
+    const auto& list = r.tiles[c];
+    ASSERT_FALSE(list.empty());
+    std::size_t total = 0, largest = 0;
+    for (std::uint32_t t : list) {
+      const std::size_t count = r.begin[t + 1] - r.begin[t];
+      EXPECT_GT(count, 0u) << "only non-empty tiles are listed";
+      EXPECT_EQ(tiles.color(t), int(c));
+      total += count, largest = std::max(largest, count);
+    }
+    for (std::size_t threads = 1; threads <= 4; ++threads) {
+      std::size_t next = 0;
+      for (std::size_t i = 0; i < threads; ++i) {
+        const auto [first, last] = r.share(c, threads, i);
+        EXPECT_EQ(first, next) << "color " << c << ", thread " << i << " of " << threads;
+        EXPECT_LE(first, last);
+        std::size_t mine = 0;
+        for (std::size_t k = first; k < last; ++k) mine += r.begin[list[k] + 1] - r.begin[list[k]];
+        EXPECT_LE(std::abs(double(mine) - double(total) / double(threads)), double(largest) + 1.0)
+            << "color " << c << ", thread " << i << " of " << threads;
+        next = last;
+      }
+      EXPECT_EQ(next, list.size()) << "color " << c << ", " << threads << " threads";
+    }
+  }
 }
 
 }  // namespace

@@ -8,7 +8,7 @@
 
 namespace mmpm {
 
-#define MMPM_DECLARE(DIM, SHAPE)                                                        \
+#define MMPM_DECLARE(DIM, SHAPE)                                                         \
   std::unique_ptr<Simulation> make_stepper_##DIM##_##SHAPE##_double(const Scene& scene); \
   std::unique_ptr<Simulation> make_stepper_##DIM##_##SHAPE##_float(const Scene& scene);
 MMPM_DECLARE(2, linear)

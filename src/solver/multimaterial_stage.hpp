@@ -17,8 +17,8 @@ namespace mmpm {
 template <int D, class Real>
 class MultimaterialStage {
  public:
-  void setup(const Scene& scene, const FieldPlan& plan, const GridView<D, Real>& grid, Real mass_threshold,
-             double dt) {
+  void setup(const Scene& scene, const FieldPlan& plan, const GridView<D, Real>& grid,
+             Real mass_threshold, double dt) {
     enabled_ = plan.multimaterial;
     fields_ = plan.fields;
     stats_.reset(plan.fields);

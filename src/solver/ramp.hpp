@@ -6,6 +6,8 @@
 
 namespace mmpm {
 
-inline double ramp_fraction(double t, double ramp) { return ramp > 0 ? std::min(1.0, t / ramp) : 1.0; }
+inline double ramp_fraction(double t, double ramp) {
+  return ramp > 0 ? std::min(1.0, t / ramp) : 1.0;
+}
 
 }  // namespace mmpm

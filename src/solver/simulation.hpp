@@ -23,12 +23,12 @@ class SimulationError : public std::runtime_error {
 };
 
 struct Energies {
-  double kinetic = 0;            // particles: sum m v^2 / 2
-  double strain = 0;             // state function of the stresses / F
-  double interface = 0;          // sum over multimaterial nodes (ALGORITHM §3.2)
-  double external_work = 0;      // tractions, gravity, moving supports
-  double damping = 0;            // removed by grid damping
-  double kinetic_unresolved = 0; // particle KE minus the KE of the grid velocity field
+  double kinetic = 0;             // particles: sum m v^2 / 2
+  double strain = 0;              // state function of the stresses / F
+  double interface = 0;           // sum over multimaterial nodes (ALGORITHM §3.2)
+  double external_work = 0;       // tractions, gravity, moving supports
+  double damping = 0;             // removed by grid damping
+  double kinetic_unresolved = 0;  // particle KE minus the KE of the grid velocity field
 };
 
 struct StepCounters {
@@ -44,7 +44,16 @@ struct Reaction {
 
 inline constexpr std::array<const char*, 7> kStageNames = {
     "sort", "p2g", "multimaterial", "grid", "g2p", "constitutive", "output"};
-enum Stage { kStageSort, kStageP2G, kStageMultimaterial, kStageGrid, kStageG2P, kStageConstitutive, kStageOutput, kStageCount };
+enum Stage {
+  kStageSort,
+  kStageP2G,
+  kStageMultimaterial,
+  kStageGrid,
+  kStageG2P,
+  kStageConstitutive,
+  kStageOutput,
+  kStageCount
+};
 
 class Simulation {
  public:

@@ -149,10 +149,7 @@ class Stepper final : public Simulation {
   std::vector<std::uint32_t> perm_, offsets_, scratch_keys_;
 
   TileLayout<D> tiles_;
-  std::vector<std::uint32_t> tile_begin_;                  // per tile, size tile_count + 1
-  std::array<std::vector<std::uint32_t>, 8> color_tiles_;  // non-empty tiles per color
-  // Per color: particles in the color's tiles [0, k), size tiles + 1.
-  std::array<std::vector<std::uint32_t>, 8> color_prefix_;
+  TileSchedule schedule_;  // tile ranges and each thread's tiles per color
   bool dirty_ = true;
 
   // Per-material particle lists (several materials, constitutive pass unfused).

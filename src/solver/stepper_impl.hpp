@@ -199,51 +199,19 @@ void Stepper<D, Shape, Real>::sort_particles() {
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::rebuild_ranges() {
   const std::size_t n = P_.n;
-  const std::uint32_t nt = tiles_.tile_count;
-  tile_begin_.assign(std::size_t(nt) + 1, 0);
-  for (std::size_t p = 0; p < n; ++p) ++tile_begin_[tiles_.tile_of_key(P_.key[p]) + 1];
-  for (std::uint32_t t = 0; t < nt; ++t) tile_begin_[t + 1] += tile_begin_[t];
-  for (auto& c : color_tiles_) c.clear();
-  for (std::uint32_t t = 0; t < nt; ++t)
-    if (tile_begin_[t + 1] > tile_begin_[t])
-      color_tiles_[std::size_t(tiles_.color(t))].push_back(t);
-  for (std::size_t c = 0; c < color_tiles_.size(); ++c) {
-    auto& prefix = color_prefix_[c];
-    prefix.assign(color_tiles_[c].size() + 1, 0);
-    for (std::size_t k = 0; k < color_tiles_[c].size(); ++k) {
-      const std::uint32_t t = color_tiles_[c][k];
-      prefix[k + 1] = prefix[k] + (tile_begin_[t + 1] - tile_begin_[t]);
-    }
-  }
+  schedule_.build(tiles_, P_.key, n);
   if (!material_particles_.empty()) {
     for (auto& l : material_particles_) l.clear();
     for (std::size_t p = 0; p < n; ++p) material_particles_[P_.mat[p]].push_back(std::uint32_t(p));
   }
 }
 
-// The tiles [first, last) of `color` that the calling thread takes in a
-// colored pass: thread i of T takes the tiles holding the i-th T-quantile of
-// the color's particles, in tile order. Particles are stored tile by tile,
-// so thread i then works on (nearly) the same particles in the colored
-// passes as in the static particle loops (schedule(static): the i-th
-// contiguous block), and a particle's cache lines stay in one core's
-// caches from pass to pass. Measured (docs/performance.md, "Thread
-// affinity of the particles"): a dynamic tile schedule moved the lines
-// between the cores every pass and cost 2D linear 32 against 21 ns/particle
-// on 2 threads. The per-tile results do not depend on which thread ran the
-// tile, so the split leaves the run bitwise unchanged.
+// The calling thread's tiles of `color` in a colored pass
+// (kernels/binning.hpp TileSchedule).
 template <int D, class Shape, class Real>
 std::pair<std::size_t, std::size_t> Stepper<D, Shape, Real>::color_share(std::size_t color) const {
-  const auto& prefix = color_prefix_[color];
-  const std::size_t tiles = prefix.size() - 1, total = prefix.back();
-  const std::size_t threads = std::size_t(omp_get_num_threads()),
-                    i = std::size_t(omp_get_thread_num());
-  const auto boundary = [&](std::size_t j) -> std::size_t {
-    if (j >= threads) return tiles;
-    return std::size_t(std::lower_bound(prefix.begin(), prefix.end(), total * j / threads) -
-                       prefix.begin());
-  };
-  return {i == 0 ? 0 : boundary(i), boundary(i + 1)};
+  return schedule_.share(color, std::size_t(omp_get_num_threads()),
+                         std::size_t(omp_get_thread_num()));
 }
 
 template <int D, class Shape, class Real>
@@ -271,12 +239,12 @@ void Stepper<D, Shape, Real>::p2g(const char* label) {
   opt.position_separation = plan_.position_separation;
   opt.inv_thickness = 1.0 / double(thickness_);
   std::size_t bad = SIZE_MAX;
-  for (std::size_t c = 0; c < color_tiles_.size(); ++c) {
-    if (color_tiles_[c].empty()) continue;
+  for (std::size_t c = 0; c < schedule_.tiles.size(); ++c) {
+    if (schedule_.tiles[c].empty()) continue;
 #pragma omp parallel reduction(min : bad) if (P_.n >= kParallelMin)
     for (auto [k, last] = color_share(c); k < last; ++k) {
-      const std::uint32_t t = color_tiles_[c][k];
-      const std::size_t b = tile_begin_[t], e = tile_begin_[t + 1];
+      const std::uint32_t t = schedule_.tiles[c][k];
+      const std::size_t b = schedule_.begin[t], e = schedule_.begin[t + 1];
       std::size_t r;
       if (plan_.multimaterial && domain_gradient_) {
         constexpr unsigned W = What | ((What & kMultimaterial) ? unsigned(kDomainGradient) : 0u);
@@ -370,12 +338,12 @@ template <unsigned What>
 void Stepper<D, Shape, Real>::g2p_colored() {
   const G2PParams q = g2p_params();
   std::vector<G2PRangeResult> res(tiles_.tile_count);
-  for (std::size_t c = 0; c < color_tiles_.size(); ++c) {
-    if (color_tiles_[c].empty()) continue;
+  for (std::size_t c = 0; c < schedule_.tiles.size(); ++c) {
+    if (schedule_.tiles[c].empty()) continue;
 #pragma omp parallel if (P_.n >= kParallelMin)
     for (auto [k, last] = color_share(c); k < last; ++k) {
-      const std::uint32_t t = color_tiles_[c][k];
-      res[t] = g2p_range_of<What>(q, tile_begin_[t], tile_begin_[t + 1]);
+      const std::uint32_t t = schedule_.tiles[c][k];
+      res[t] = g2p_range_of<What>(q, schedule_.begin[t], schedule_.begin[t + 1]);
     }
   }
   collect(res);
@@ -383,7 +351,7 @@ void Stepper<D, Shape, Real>::g2p_colored() {
 
 // One parallel region for all materials, each thread on its own
 // contiguous block of particles (the block of the static particle loops,
-// see color_share): a material's list is cut at the block's ends, so a
+// kernels/binning.hpp TileSchedule): a material's list is cut at the block's ends, so a
 // thread updates only particles it touched in the passes before and the
 // threads share the work of every material without a barrier per material.
 template <int D, class Shape, class Real>
