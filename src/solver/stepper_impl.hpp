@@ -57,8 +57,12 @@ void Stepper<D, Shape, Real>::setup_grid() {
     }
   }
   // Tile edge (bench/RESULTS.md §1): 16 in 2D and 8 in 3D scatter fastest on
-  // this machine; smaller grids step down so every color keeps at least 8
-  // tiles for two threads. Chosen from the grid alone, never from the
+  // this machine; smaller grids step down so every color keeps at least 32
+  // tiles. A thread's share of a color is cut at tile boundaries
+  // (TileSchedule), so the two threads' work differs by up to one tile: with
+  // 8 tiles per color the 3D block of bench_step (28 x 28 x 26 cells)
+  // stepped 1.5x faster on 2 threads, with 43 (edge 4) 1.9x
+  // (docs/performance.md). Chosen from the grid alone, never from the
   // thread count, so the summation order (and the result) is the same for
   // any number of threads.
   int T = g.tile;
@@ -67,7 +71,7 @@ void Stepper<D, Shape, Real>::setup_grid() {
     for (; T > 4; T /= 2) {
       std::size_t tiles = 1;
       for (int d = 0; d < D; ++d) tiles *= std::size_t((g.cells[d] + T - 1) / T);
-      if (tiles >= std::size_t(8) << D) break;
+      if (tiles >= std::size_t(32) << D) break;
     }
   }
   tiles_.setup(T, g.cells);
