@@ -124,8 +124,15 @@ void bm_constitutive(benchmark::State& state, int threads) {
   c.density = 1.2e-3;
   c.plane_stress = false;
   const double dt = 1e-4;
+  const IsotropicPoint<D, Real> update(c, dt);
   for (auto _ : state) {
-    isotropic_update<D, Real>(P, nullptr, P.n, c, dt);
+    // As Stepper::constitutive runs it: each thread its block of particles.
+#pragma omp parallel if (P.n >= kParallelMin)
+    {
+      const auto [first, last] = thread_block(P.n, std::size_t(omp_get_num_threads()),
+                                              std::size_t(omp_get_thread_num()));
+      update_particles(P, nullptr, first, last, update);
+    }
     keep(P.s[0]);
     benchmark::ClobberMemory();
   }

@@ -29,18 +29,6 @@ struct ElasticKernelConstants {
   double C3[6][6] = {};
 };
 
-// Loops over the particles of one material: idx[k] (or k when idx is null).
-template <class Body>
-inline void for_particles(const std::uint32_t* idx, std::size_t count, Body&& body) {
-  if (idx) {
-#pragma omp parallel for schedule(static) if (count >= kParallelMin)
-    for (std::size_t k = 0; k < count; ++k) body(std::size_t(idx[k]));
-  } else {
-#pragma omp parallel for schedule(static) if (count >= kParallelMin)
-    for (std::size_t k = 0; k < count; ++k) body(k);
-  }
-}
-
 template <int D, class Real>
 inline Real volume_ratio(const ParticleView<D, Real>& P, std::size_t p, Real dt) {
   if constexpr (D == 2) {
@@ -56,9 +44,10 @@ inline Real volume_ratio(const ParticleView<D, Real>& P, std::size_t p, Real dt)
 }
 
 // Per-particle updates: one functor per material type, applied to particle
-// p. The loop drivers below run them as a separate pass; the G2P gradient
-// pass runs them straight after L (kernels/g2p.hpp kStressUpdate), so L,
-// sigma and V are still in registers or L1 (docs/performance.md).
+// p. The Stepper's constitutive pass runs them over each thread's block of
+// particles (update_particles); with fuse_constitutive the G2P gradient
+// pass runs the isotropic one straight after L (kernels/g2p.hpp
+// kStressUpdate; docs/performance.md measured no gain).
 template <int D, class Real>
 struct IsotropicPoint {
   Real dt = 0, lam = 0, mu2 = 0, Ep = 0, nu = 0;
@@ -204,27 +193,6 @@ inline void update_particles(const ParticleView<D, Real>& P, const std::uint32_t
   } else {
     for (std::size_t k = first; k < last; ++k) f(P, k);
   }
-}
-
-template <int D, class Real>
-void isotropic_update(const ParticleView<D, Real>& P, const std::uint32_t* idx, std::size_t count,
-                      const ElasticKernelConstants& c, double dt) {
-  const IsotropicPoint<D, Real> f(c, dt);
-  for_particles(idx, count, [&](std::size_t p) { f(P, p); });
-}
-
-template <int D, class Real>
-void anisotropic_update(const ParticleView<D, Real>& P, const std::uint32_t* idx, std::size_t count,
-                        const ElasticKernelConstants& c, double dt) {
-  const AnisotropicPoint<D, Real> f(c, dt);
-  for_particles(idx, count, [&](std::size_t p) { f(P, p); });
-}
-
-template <int D, class Real>
-void neohookean_update(const ParticleView<D, Real>& P, const std::uint32_t* idx, std::size_t count,
-                       const ElasticKernelConstants& c, double dt) {
-  const NeoHookeanPoint<D, Real> f(c, dt);
-  for_particles(idx, count, [&](std::size_t p) { f(P, p); });
 }
 
 // A stressed particle is sound when its volume is positive and finite and

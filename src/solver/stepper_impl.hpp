@@ -363,9 +363,8 @@ void Stepper<D, Shape, Real>::constitutive() {
   const std::size_t n = P_.n;
 #pragma omp parallel if (n >= kParallelMin)
   {
-    const std::size_t threads = std::size_t(omp_get_num_threads()),
-                      i = std::size_t(omp_get_thread_num());
-    const std::size_t lo = n * i / threads, hi = n * (i + 1) / threads;
+    const auto [lo, hi] = thread_block(n, std::size_t(omp_get_num_threads()),
+                                       std::size_t(omp_get_thread_num()));
     for (std::size_t mi = 0; mi < materials_.size(); ++mi) {
       const MaterialModel& mat = materials_[mi];
       const std::uint32_t* idx = nullptr;
