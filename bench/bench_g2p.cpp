@@ -23,15 +23,15 @@ std::array<int, 3> g2p_cells() {
   return D == 2 ? std::array<int, 3>{254, 254, 1} : std::array<int, 3>{36, 36, 36};
 }
 
-// The tile-change test the Stepper's KeyFn does after moving a particle.
+// The tile-change test as the Stepper runs it (its KeyFn).
 template <int D, class Real>
-struct TileKeyFn {
-  const Binning<D, Real>* bins;
-  const ParticleView<D, Real>* P;
-  const GridView<D, Real>* G;
-  std::uint32_t tile(std::size_t p) const { return bins->tiles.tile_of_key(bins->key_of(*P, *G, p)); }
-  std::uint32_t tile_of_key(std::uint32_t k) const { return bins->tiles.tile_of_key(k); }
-};
+PositionTile<D, Real> position_tile(const Binning<D, Real>& bins, const ParticleView<D, Real>& P,
+                                    const GridView<D, Real>& G) {
+  PositionTile<D, Real> k{bins.tiles, G.origin, {}, {}};
+  for (int d = 0; d < 3; ++d) k.inv_h[std::size_t(d)] = Real(1) / G.h[std::size_t(d)];
+  for (int d = 0; d < D; ++d) k.x[std::size_t(d)] = P.x[d];
+  return k;
+}
 
 template <int D, class Shape, class Real>
 struct G2PFixture {
@@ -75,7 +75,7 @@ void bm_g2p(benchmark::State& state, int threads) {
   G2PParams q;
   q.dt = 1e-3;
   q.flip = 0.99;
-  const TileKeyFn<D, Real> key_of{&fx.bins, &P, &G};
+  const PositionTile<D, Real> key_of = position_tile(fx.bins, P, G);
   const std::size_t n = P.n, chunks = chunk_count(n);
   std::vector<G2PRangeResult> res(chunks);
   for (auto _ : state) {
@@ -83,8 +83,10 @@ void bm_g2p(benchmark::State& state, int threads) {
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
     for (std::size_t c = 0; c < chunks; ++c) {
       const std::size_t b = c * kReduceChunk, e = std::min(n, b + kReduceChunk);
-      res[c] = Windowed ? g2p_range<D, Shape, Real, What, false, false, false>(P, G, V, q, key_of, b, e)
-                        : g2p_range_pointwise<D, Shape, Real, What, false, false, false>(P, G, V, q, key_of, b, e);
+      res[c] = Windowed
+                   ? g2p_range<D, Shape, Real, What, false, false, false>(P, G, V, q, key_of, b, e)
+                   : g2p_range_pointwise<D, Shape, Real, What, false, false, false>(P, G, V, q,
+                                                                                    key_of, b, e);
     }
     keep(res.data());
     benchmark::ClobberMemory();
@@ -96,7 +98,8 @@ void bm_g2p(benchmark::State& state, int threads) {
     }
   set_ns_per_particle(state, double(n));
   // Particle bytes: read x, v, key (+ lp), write x, v, L.
-  const double bytes = double(sizeof(Real)) * (4 * D + D * D + (std::is_same_v<Shape, GimpShape> ? D : 0)) + 4.0;
+  const double bytes =
+      double(sizeof(Real)) * (4 * D + D * D + (std::is_same_v<Shape, GimpShape> ? D : 0)) + 4.0;
   set_rate(state, "particle_GBps", double(n) * bytes);
   set_rate(state, "Gnode_reads_per_s", double(n) * Stencil<D, Shape, Real>::count);
   state.counters["threads"] = threads;
@@ -129,8 +132,8 @@ void bm_constitutive(benchmark::State& state, int threads) {
     // As Stepper::constitutive runs it: each thread its block of particles.
 #pragma omp parallel if (P.n >= kParallelMin)
     {
-      const auto [first, last] = thread_block(P.n, std::size_t(omp_get_num_threads()),
-                                              std::size_t(omp_get_thread_num()));
+      const auto [first, last] =
+          thread_block(P.n, std::size_t(omp_get_num_threads()), std::size_t(omp_get_thread_num()));
       update_particles(P, nullptr, first, last, update);
     }
     keep(P.s[0]);
@@ -152,15 +155,16 @@ void register_g2p_case() {
   for (const char* kernel : {"window", "pointwise"})
     for (int threads : {1, 2}) {
       const bool windowed = kernel[0] == 'w';
-      const std::string name = std::string(windowed ? "g2p" : "g2p_pointwise") + "/dim:" + std::to_string(D) +
-                               "/shape:" + Shape::name + "/real:" + real_name<Real>() +
-                               "/threads:" + std::to_string(threads);
-      auto* b = benchmark::RegisterBenchmark(name.c_str(), [threads, windowed](benchmark::State& st) {
-        if (windowed)
-          bm_g2p<D, Shape, Real, true>(st, threads);
-        else
-          bm_g2p<D, Shape, Real, false>(st, threads);
-      });
+      const std::string name = std::string(windowed ? "g2p" : "g2p_pointwise") +
+                               "/dim:" + std::to_string(D) + "/shape:" + Shape::name +
+                               "/real:" + real_name<Real>() + "/threads:" + std::to_string(threads);
+      auto* b =
+          benchmark::RegisterBenchmark(name.c_str(), [threads, windowed](benchmark::State& st) {
+            if (windowed)
+              bm_g2p<D, Shape, Real, true>(st, threads);
+            else
+              bm_g2p<D, Shape, Real, false>(st, threads);
+          });
       configure(b->UseRealTime()->Unit(benchmark::kMillisecond), 0.1);
     }
 }
@@ -172,11 +176,11 @@ void register_dim_real() {
   register_g2p_case<D, BSpline2Shape, Real>();
   register_g2p_case<D, BSpline3Shape, Real>();
   for (int threads : {1, 2}) {
-    const std::string name = "constitutive/dim:" + std::to_string(D) + "/law:isotropic/real:" +
-                             real_name<Real>() + "/threads:" + std::to_string(threads);
-    auto* b = benchmark::RegisterBenchmark(name.c_str(), [threads](benchmark::State& st) {
-      bm_constitutive<D, Real>(st, threads);
-    });
+    const std::string name = "constitutive/dim:" + std::to_string(D) +
+                             "/law:isotropic/real:" + real_name<Real>() +
+                             "/threads:" + std::to_string(threads);
+    auto* b = benchmark::RegisterBenchmark(
+        name.c_str(), [threads](benchmark::State& st) { bm_constitutive<D, Real>(st, threads); });
     configure(b->UseRealTime()->Unit(benchmark::kMillisecond), 0.1);
   }
 }

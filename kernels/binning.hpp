@@ -134,6 +134,23 @@ inline int cell_of(Real x, Real origin, Real inv_h) {
   return int(std::floor((x - origin) * inv_h));
 }
 
+// The tile of particle p's current position, next to the tile in its key:
+// G2P's test for a particle that moved into another tile (kernels/g2p.hpp
+// KeyFn). inv_h is stored, not h: a division per particle and direction
+// would cost the gather pass a measurable share.
+template <int D, class Real>
+struct PositionTile {
+  TileLayout<D> tiles;
+  std::array<Real, 3> origin{}, inv_h{};
+  std::array<const Real*, D> x{};
+  [[gnu::always_inline]] std::uint32_t tile(std::size_t p) const {
+    std::array<int, 3> c{0, 0, 0};
+    for (int d = 0; d < D; ++d) c[d] = cell_of(x[d][p], origin[d], inv_h[d]);
+    return tiles.tile_of_key(tiles.key(c));
+  }
+  std::uint32_t tile_of_key(std::uint32_t k) const { return tiles.tile_of_key(k); }
+};
+
 // Stable counting sort: fills perm so that perm[new] = old, and offsets
 // (size key_count + 1) with the first sorted position of every key.
 inline void counting_sort(const std::uint32_t* key, std::size_t n, std::uint32_t key_count,

@@ -69,17 +69,7 @@ class Stepper final : public Simulation {
   // The tile test G2P runs on every particle: inline, from copies of the
   // layout and the grid geometry (a call per particle cost ~12 % of a 2D
   // linear step).
-  struct KeyFn {
-    TileLayout<D> tiles;
-    std::array<Real, 3> origin, inv_h;
-    std::array<const Real*, D> x;
-    [[gnu::always_inline]] std::uint32_t tile(std::size_t p) const {
-      std::array<int, 3> c{0, 0, 0};
-      for (int d = 0; d < D; ++d) c[d] = cell_of(x[d][p], origin[d], inv_h[d]);
-      return tiles.tile_of_key(tiles.key(c));
-    }
-    std::uint32_t tile_of_key(std::uint32_t k) const { return tiles.tile_of_key(k); }
-  };
+  using KeyFn = PositionTile<D, Real>;
   KeyFn key_fn() const {
     KeyFn k{tiles_, G_.origin, {Real(1) / G_.h[0], Real(1) / G_.h[1], Real(1) / G_.h[2]}, {}};
     for (int d = 0; d < D; ++d) k.x[d] = P_.x[d];
