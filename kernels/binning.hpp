@@ -136,8 +136,8 @@ inline int cell_of(Real x, Real origin, Real inv_h) {
 
 // The tile of particle p's current position, next to the tile in its key:
 // G2P's test for a particle that moved into another tile (kernels/g2p.hpp
-// KeyFn). inv_h is stored, not h: a division per particle and direction
-// would cost the gather pass a measurable share.
+// KeyFn). inv_h is stored, not h, so the test multiplies instead of
+// dividing per particle and direction.
 template <int D, class Real>
 struct PositionTile {
   TileLayout<D> tiles;
