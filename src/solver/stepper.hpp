@@ -107,7 +107,6 @@ class Stepper final : public Simulation {
   void finish_velocities(bool with_dvel);
   void apply_boundaries(bool with_dvel);
   void update_tractions();
-  void check_volumes();
   [[noreturn]] void fail_particle(const char* stage, std::size_t p, const std::string& why) const;
   void tic() { t0_ = Clock::now(); }
   void toc(Stage s) {

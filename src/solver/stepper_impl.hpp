@@ -358,13 +358,17 @@ void Stepper<D, Shape, Real>::g2p_colored() {
 // kernels/binning.hpp TileSchedule): a material's list is cut at the block's ends, so a
 // thread updates only particles it touched in the passes before and the
 // threads share the work of every material without a barrier per material.
+// Then each thread checks its own block for inverted or blown-up particles
+// (non-positive or non-finite volume, non-finite stress) while the block is
+// still in its cache.
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::constitutive() {
   const std::size_t n = P_.n;
-#pragma omp parallel if (n >= kParallelMin)
+  std::size_t bad = SIZE_MAX;
+#pragma omp parallel reduction(min : bad) if (n >= kParallelMin)
   {
-    const auto [lo, hi] = thread_block(n, std::size_t(omp_get_num_threads()),
-                                       std::size_t(omp_get_thread_num()));
+    const auto [lo, hi] =
+        thread_block(n, std::size_t(omp_get_num_threads()), std::size_t(omp_get_thread_num()));
     for (std::size_t mi = 0; mi < materials_.size(); ++mi) {
       const MaterialModel& mat = materials_[mi];
       const std::uint32_t* idx = nullptr;
@@ -389,7 +393,11 @@ void Stepper<D, Shape, Real>::constitutive() {
           break;
       }
     }
+    for (std::size_t p = lo; p < hi; ++p)
+      if (!(P_.V[p] > Real(0)) || !std::isfinite(P_.V[p]) || !std::isfinite(P_.s[0][p]))
+        bad = std::min(bad, p);
   }
+  if (bad != SIZE_MAX) fail_particle("constitutive", bad, "J <= 0 or a non-finite stress/volume");
 }
 
 template <int D, class Shape, class Real>
@@ -405,21 +413,8 @@ void Stepper<D, Shape, Real>::gradient_and_stress() {
     toc(kStageG2P);
     tic();
     constitutive();
-    check_volumes();
     toc(kStageConstitutive);
   }
-}
-
-// Non-finite or non-positive volumes mark an inverted or blown-up particle.
-template <int D, class Shape, class Real>
-void Stepper<D, Shape, Real>::check_volumes() {
-  const std::size_t n = P_.n;
-  std::size_t bad = SIZE_MAX;
-#pragma omp parallel for schedule(static) reduction(min : bad) if (n >= kParallelMin)
-  for (std::size_t p = 0; p < n; ++p)
-    if (!(P_.V[p] > Real(0)) || !std::isfinite(P_.V[p]) || !std::isfinite(P_.s[0][p]))
-      bad = std::min(bad, p);
-  if (bad != SIZE_MAX) fail_particle("constitutive", bad, "J <= 0 or a non-finite stress/volume");
 }
 
 template <int D, class Shape, class Real>
