@@ -296,6 +296,15 @@ STEP_SCENES = [
 ]
 
 
+def step_scenes():
+    """(scene name, label, benchmark-name filter) for each STEP_SCENES row."""
+    for scene, label in STEP_SCENES:
+        if isinstance(scene, tuple):
+            yield scene[0], label, {"scene": scene[0], **scene[1]}
+        else:
+            yield scene, label, {"scene": scene}
+
+
 def step_section(R):
     ns = "ns_per_particle"
     out = ["## 3. Whole step through the Simulation interface (ns/particle/step)", "",
@@ -306,11 +315,7 @@ def step_section(R):
     header = ["scene", "particles", "fields", "1 thread", "spread", "2 threads", "spread",
               "speed-up"] + [s + " (1t)" for s in STAGES]
     rows = []
-    for scene, label in STEP_SCENES:
-        kw = {"scene": scene}
-        if isinstance(scene, tuple):
-            kw = {"scene": scene[0], **scene[1]}
-            scene = scene[0]
+    for scene, label, kw in step_scenes():
         v1 = R.value("step", ns, threads=1, **kw)
         v2 = R.value("step", ns, threads=2, **kw)
         if v1 is None and v2 is None:
@@ -346,11 +351,7 @@ def stage_speedup_table(R):
            "1-thread / 2-thread stage time, medians of the Stepper's timers over the passes; "
            "in parentheses the stage's share of the 1-thread step. Marked * below 1.8×.", ""]
     rows = []
-    for scene, label in STEP_SCENES:
-        kw = {"scene": scene}
-        if isinstance(scene, tuple):
-            kw = {"scene": scene[0], **scene[1]}
-            scene = scene[0]
+    for scene, label, kw in step_scenes():
         total = sum(R.value("step", f"stage_{s}_ns_per_particle", threads=1, **kw) or 0
                     for s in STAGES)
         if total <= 0:

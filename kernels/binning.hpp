@@ -143,6 +143,14 @@ struct PositionTile {
   TileLayout<D> tiles;
   std::array<Real, 3> origin{}, inv_h{};
   std::array<const Real*, D> x{};
+  // From the grid's origin and cell size h, and the particles' x arrays.
+  template <class Positions>
+  static PositionTile of(const TileLayout<D>& layout, const std::array<Real, 3>& grid_origin,
+                         const std::array<Real, 3>& h, const Positions& positions) {
+    PositionTile k{layout, grid_origin, {Real(1) / h[0], Real(1) / h[1], Real(1) / h[2]}, {}};
+    for (int d = 0; d < D; ++d) k.x[std::size_t(d)] = positions[d];
+    return k;
+  }
   [[gnu::always_inline]] std::uint32_t tile(std::size_t p) const {
     std::array<int, 3> c{0, 0, 0};
     for (int d = 0; d < D; ++d) c[d] = cell_of(x[d][p], origin[d], inv_h[d]);

@@ -215,17 +215,10 @@ struct IsotropicStressUpdate {
     bool stressed = false;  // false: rigid (no stress, no volume change)
   };
   const Entry* table = nullptr;  // per material
-  // One material: its constants held by value, so that a local copy of
-  // this functor keeps them in registers (stores to the particle arrays may
-  // alias a table in memory, which forces a reload per particle).
-  Entry only;
-  bool uniform = false;
-  IsotropicStressUpdate(const Entry* t, std::size_t materials)
-      : table(t), only(materials > 0 ? t[0] : Entry{}), uniform(materials == 1) {}
   // Updates sigma and V of particle p from its L; false when the particle
   // is no longer sound.
   [[gnu::always_inline]] bool operator()(const ParticleView<D, Real>& P, std::size_t p) const {
-    const Entry& e = uniform ? only : table[P.mat[p]];
+    const Entry& e = table[P.mat[p]];
     if (e.stressed) e.update(P, p);
     return particle_sound(P, p);
   }

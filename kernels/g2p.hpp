@@ -163,7 +163,6 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
   G2PRangeResult r;
   const Real dt = Real(q.dt), flip = Real(q.flip), pic = Real(1) - Real(q.flip);
   G2PGather<D, Shape, Real, Windowed> st(G);
-  const StressFn S = stress;  // a local copy: its constants cannot alias the particle stores
   constexpr bool kScatter = (What & kScatterMomentum) != 0;
   static_assert((What & kStressUpdate) == 0 || (What & kVelocityGradient) != 0,
                 "the stress update needs the velocity gradient");
@@ -236,7 +235,7 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
     if constexpr ((What & kVelocityGradient) != 0)
       for (int c = 0; c < D * D; ++c) P.L[c][p] = L[c];
     if constexpr ((What & kStressUpdate) != 0)
-      if (!S(P, p) && r.unsound == SIZE_MAX) r.unsound = p;
+      if (!stress(P, p) && r.unsound == SIZE_MAX) r.unsound = p;
     if constexpr ((What & kCommitPosition) != 0) {
       for (int d = 0; d < D; ++d) P.x[d][p] = P.x_next[d][p];
       if (key_of.tile(p) != key_of.tile_of_key(P.key[p])) r.moved_tile = true;

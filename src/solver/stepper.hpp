@@ -70,11 +70,7 @@ class Stepper final : public Simulation {
   // layout and the grid geometry (a call per particle cost ~12 % of a 2D
   // linear step).
   using KeyFn = PositionTile<D, Real>;
-  KeyFn key_fn() const {
-    KeyFn k{tiles_, G_.origin, {Real(1) / G_.h[0], Real(1) / G_.h[1], Real(1) / G_.h[2]}, {}};
-    for (int d = 0; d < D; ++d) k.x[d] = P_.x[d];
-    return k;
-  }
+  KeyFn key_fn() const { return KeyFn::of(tiles_, G_.origin, G_.h, P_.x); }
 
   void setup_particles(const ParticleSeeds& seeds);
   void setup_grid();

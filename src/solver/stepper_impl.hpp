@@ -290,8 +290,7 @@ G2PRangeResult Stepper<D, Shape, Real>::g2p_range_of(const G2PParams& q, std::si
   auto run = [&]<bool MF, bool TR, bool GR>() {
     if constexpr ((What & kStressUpdate) != 0)
       return g2p_range<D, Shape, Real, What, MF, TR, GR>(
-          P_, G_, GV_, q, key_of, b, e,
-          IsotropicStressUpdate<D, Real>(stress_table_.data(), stress_table_.size()));
+          P_, G_, GV_, q, key_of, b, e, IsotropicStressUpdate<D, Real>{stress_table_.data()});
     else
       return g2p_range<D, Shape, Real, What, MF, TR, GR>(P_, G_, GV_, q, key_of, b, e);
   };
@@ -394,8 +393,7 @@ void Stepper<D, Shape, Real>::constitutive() {
       }
     }
     for (std::size_t p = lo; p < hi; ++p)
-      if (!(P_.V[p] > Real(0)) || !std::isfinite(P_.V[p]) || !std::isfinite(P_.s[0][p]))
-        bad = std::min(bad, p);
+      if (!particle_sound(P_, p)) bad = std::min(bad, p);
   }
   if (bad != SIZE_MAX) fail_particle("constitutive", bad, "J <= 0 or a non-finite stress/volume");
 }
