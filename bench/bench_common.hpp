@@ -363,7 +363,7 @@ std::size_t p2g_atomic(const ParticleView<D, Real>& P, const GridView<D, Real>& 
   std::size_t bad = SIZE_MAX;
 #pragma omp parallel reduction(min : bad)
   {
-    Stencil<D, Shape, Real> st;
+    Stencil<D, Shape, Real> st{};
 #pragma omp for schedule(static)
     for (std::size_t p = 0; p < n; ++p) {
       if (!st.build(P, G, inv_h, p)) {

@@ -10,6 +10,7 @@
 
 #include "kernels/constitutive.hpp"
 #include "kernels/grid_update.hpp"
+#include "kernels/weight_batch.hpp"
 #include "kernels/weights.hpp"
 #include "kernels/window_block.hpp"
 
@@ -56,35 +57,35 @@ template <int D, class Shape, class Real, bool Windowed>
 struct G2PGather {
   using Win = Window<D, Shape, Real>;
   using St = Stencil<D, Shape, Real>;
-  std::conditional_t<Windowed, Win, St> w;
+  using Weights = std::conditional_t<Windowed, Win, St>;
+  struct NoBuilder {
+    explicit NoBuilder(const GridView<D, Real>&) {}
+  };
+  std::conditional_t<Windowed, WindowBuilder<D, Shape, Real>, NoBuilder> builder;
   const GridView<D, Real>& grid_;
   std::array<Real, 3> inv_h_;
   typename Win::Offsets offsets{};
 
   explicit G2PGather(const GridView<D, Real>& grid)
-      : w(make(grid)),
+      : builder(grid),
         grid_(grid),
         inv_h_{Real(1) / grid.h[0], Real(1) / grid.h[1], Real(1) / grid.h[2]} {
     if constexpr (Windowed) offsets = Win::offsets(grid);
   }
-  static auto make(const GridView<D, Real>& grid) {
-    if constexpr (Windowed)
-      return Win(grid);
-    else
-      return St{};
-  }
 
-  [[gnu::always_inline]] bool build(const ParticleView<D, Real>& P, std::size_t p) {
+  [[gnu::always_inline]] bool build(const ParticleView<D, Real>& P, std::size_t p,
+                                    Weights& w) const {
     if constexpr (Windowed)
-      return w.build(P, p);
+      return builder.build(P, p, w);
     else
       return w.build(P, grid_, inv_h_, p);
   }
 
   // vn, dv: velocity and its change over the step; L row-major dv_a/dx_b.
   template <bool Motion, bool Gradient>
-  [[gnu::always_inline]] void gather(const GridVelocity<D, Real>& V, std::size_t field_offset,
-                                     Real* vn, Real* dv, Real* L) const {
+  [[gnu::always_inline]] void gather(const Weights& w, const GridVelocity<D, Real>& V,
+                                     std::size_t field_offset, Real* vn, Real* dv,
+                                     Real* L) const {
     const std::size_t b = w.base + field_offset;
     if constexpr (!Windowed) {
       for (int k = 0; k < St::count; ++k) {
@@ -173,24 +174,28 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
   Block block;
   const auto off =
       Windowed ? Window<D, Shape, Real>::offsets(G) : typename Window<D, Shape, Real>::Offsets{};
-  auto scatter_momentum = [&](std::size_t p, std::size_t fo) {
+  using Weights = typename G2PGather<D, Shape, Real, Windowed>::Weights;
+  auto scatter_momentum = [&](const Weights& w, std::size_t p, std::size_t fo)
+                              __attribute__((always_inline)) {
     ScatterSource<D, Real> s;
     for (int d = 0; d < D; ++d) s.mv[d] = P.m[p] * P.v[d][p];
     if constexpr (Windowed) {
-      block.at(st.w.base + fo, G, off);
-      block.accumulate(st.w, s);
+      block.at(w.base + fo, G, off);
+      block.accumulate(w, s);
     } else {
-      for (int k = 0; k < st.w.count; ++k) {
-        const std::size_t i = st.w.base + fo + st.w.node[k];
-        for (int d = 0; d < D; ++d) G.p[d][i] += st.w.w[k] * s.mv[d];
+      for (int k = 0; k < w.count; ++k) {
+        const std::size_t i = w.base + fo + w.node[k];
+        for (int d = 0; d < D; ++d) G.p[d][i] += w.w[k] * s.mv[d];
       }
     }
   };
-  for (std::size_t p = begin; p < end; ++p) {
-    if (!st.build(P, p)) {
+  auto build = [&](std::size_t p, Weights& w) __attribute__((always_inline)) { return st.build(P, p, w); };
+  auto transfer = [&](std::size_t p, const Weights* weights) __attribute__((always_inline)) {
+    if (!weights) {
       if (r.bad == SIZE_MAX) r.bad = p;
-      continue;
+      return true;
     }
+    const Weights& w = *weights;
     const int field = MultiField ? int(P.field[p]) : 0;
     const std::size_t fo = MultiField ? std::size_t(field) * G.nodes : 0;
     if constexpr ((What & kUpdateMotion) != 0) {
@@ -202,14 +207,13 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
           else
             P.x[d][p] += dt * P.v[d][p];
         }
-        if (!P.x_next[0] && key_of.tile(p) != key_of.tile_of_key(P.key[p])) r.moved_tile = true;
-        if constexpr (kScatter) scatter_momentum(p, fo);
-        continue;
+        if constexpr (kScatter) scatter_momentum(w, p, fo);
+        return true;
       }
     }
     Real vn[D] = {}, dv[D] = {}, L[D * D] = {};
-    st.template gather<(What & kUpdateMotion) != 0, (What & kVelocityGradient) != 0>(V, fo, vn, dv,
-                                                                                     L);
+    st.template gather<(What & kUpdateMotion) != 0, (What & kVelocityGradient) != 0>(w, V, fo, vn,
+                                                                                     dv, L);
     if constexpr ((What & kUpdateMotion) != 0) {
       bool finite = true;
       double work = 0;
@@ -229,19 +233,23 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
       }
       if constexpr (Traction || Gravity) r.external_work += work * q.dt;
       if (!finite && r.bad == SIZE_MAX) r.bad = p;
-      if (!P.x_next[0] && key_of.tile(p) != key_of.tile_of_key(P.key[p])) r.moved_tile = true;
-      if constexpr (kScatter) scatter_momentum(p, fo);
+      if constexpr (kScatter) scatter_momentum(w, p, fo);
     }
     if constexpr ((What & kVelocityGradient) != 0)
       for (int c = 0; c < D * D; ++c) P.L[c][p] = L[c];
     if constexpr ((What & kStressUpdate) != 0)
       if (!stress(P, p) && r.unsound == SIZE_MAX) r.unsound = p;
-    if constexpr ((What & kCommitPosition) != 0) {
+    if constexpr ((What & kCommitPosition) != 0)
       for (int d = 0; d < D; ++d) P.x[d][p] = P.x_next[d][p];
-      if (key_of.tile(p) != key_of.tile_of_key(P.key[p])) r.moved_tile = true;
-    }
-  }
+    return true;
+  };
+  for_each_weighted<Weights>(begin, end, build, transfer);
   if constexpr (kScatter && Windowed) block.flush(G, off);
+  // Positions moved in this pass (in place, or committed from x_next): did a
+  // particle leave its tile? One vectorised test of the range, after the loop.
+  constexpr bool kMoves = (What & (kCommitPosition | kUpdateMotion)) != 0;
+  if (kMoves && ((What & kCommitPosition) != 0 || !P.x_next[0]))
+    r.moved_tile = key_of.any_moved(P.key, begin, end);
   return r;
 }
 

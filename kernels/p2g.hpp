@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "kernels/weight_batch.hpp"
 #include "kernels/weights.hpp"
 #include "kernels/window_block.hpp"
 
@@ -22,7 +23,7 @@ std::size_t p2g_range_pointwise(const ParticleView<D, Real>& P, const GridView<D
   constexpr int NS = kStressComponents<D>;
   const std::array<Real, 3> inv_h{Real(1) / G.h[0], Real(1) / G.h[1], Real(1) / G.h[2]};
   const Real inv_t = Real(opt.inv_thickness);
-  Stencil<D, Shape, Real> st;
+  Stencil<D, Shape, Real> st{};
   for (std::size_t p = begin; p < end; ++p) {
     if (!st.build(P, G, inv_h, p)) return p;
     const std::size_t fo = MultiField ? std::size_t(P.field[p]) * G.nodes : 0;
@@ -98,13 +99,11 @@ std::size_t p2g_range(const ParticleView<D, Real>& particles, const GridView<D, 
   const Real inv_t = Real(opt.inv_thickness);
   const auto off = Win::offsets(G);
   Block block;
-  Win win(G);
-  for (std::size_t p = begin; p < end; ++p) {
-    if (!win.build(P, p)) {
-      block.flush(G, off);
-      return p;
-    }
-    block.at(win.base + (MultiField ? std::size_t(P.field[p]) * G.nodes : 0), G, off);
+  const WindowBuilder<D, Shape, Real> builder(G);
+  auto build = [&](std::size_t p, Win& w) __attribute__((always_inline)) { return builder.build(P, p, w); };
+  auto scatter = [&](std::size_t p, const Win* win) __attribute__((always_inline)) {
+    if (!win) return false;
+    block.at(win->base + (MultiField ? std::size_t(P.field[p]) * G.nodes : 0), G, off);
     ScatterSource<D, Real> q;
     q.m = P.m[p];
     for (int d = 0; d < D; ++d) q.mv[d] = q.m * P.v[d][p];
@@ -118,10 +117,12 @@ std::size_t p2g_range(const ParticleView<D, Real>& particles, const GridView<D, 
       for (int d = 0; d < D; ++d)
         q.mw[d] = q.m * (opt.position_separation ? P.x[d][p] : P.x[d][p] - P.x0[d][p]);
     }
-    block.accumulate(win, q);
-  }
+    block.accumulate(*win, q);
+    return true;
+  };
+  const std::size_t stop = for_each_weighted<Win>(begin, end, build, scatter);
   block.flush(G, off);
-  return end;
+  return stop;
 }
 
 }  // namespace mmpm

@@ -14,10 +14,11 @@ template <int D, class Shape, class Real>
 struct Stencil {
   static constexpr int S = Shape::S;
   static constexpr int count = D == 2 ? S * S : S * S * S;
-  std::size_t base = 0;                        // node index of the lowest corner (field 0)
-  std::array<Real, count> w{};                 // S_ip, x fastest
-  std::array<std::array<Real, D>, count> g{};  // G_ip
-  std::array<std::size_t, count> node{};       // node offsets relative to base
+  // Filled by build (no default initialisers, as kernels/window.hpp Window).
+  std::size_t base;                          // node index of the lowest corner (field 0)
+  std::array<Real, count> w;                 // S_ip, x fastest
+  std::array<std::array<Real, D>, count> g;  // G_ip
+  std::array<std::size_t, count> node;       // node offsets relative to base
 
   // Returns false when the stencil leaves the grid.
   bool build(const ParticleView<D, Real>& P, const GridView<D, Real>& G,

@@ -63,9 +63,12 @@ struct Window {
   using VA = Lanes<Real, W * DP>;  // every direction's 1D weights
   using Offsets = std::array<std::size_t, R>;
 
-  std::size_t base = 0;  // node index of the window's lowest corner (field 0)
-  VA wa{};               // 1D weights, lane d * W + k
-  VA dwa{};              // 1D derivatives, already divided by h
+  // Filled by WindowBuilder::build. No default initialisers: the transfers
+  // keep a batch of windows on the stack (kernels/weight_batch.hpp), and
+  // zeroing it on every call was measurable.
+  std::size_t base;  // node index of the window's lowest corner (field 0)
+  VA wa;             // 1D weights, lane d * W + k
+  VA dwa;            // 1D derivatives, already divided by h
 
   // Every grid direction must hold a whole window (W nodes); else the caller
   // uses the pointwise kernels.
@@ -123,57 +126,13 @@ struct Window {
       return yz<u>(wa, dwa);
   }
 
-  explicit Window(const GridView<D, Real>& G) {
-    VA ih{};
-    for (int d = 0; d < DP; ++d) {
-      ih[d] = d < D ? Real(1) / G.h[std::size_t(d)] : Real(1);
-      if (d < D)
-        inv_h[d] = ih[d], origin[d] = G.origin[std::size_t(d)],
-        n[d] = G.nodes_per_dim[std::size_t(d)];
-    }
-    inv_h_lanes = spread(ih, std::make_index_sequence<W * DP>{});
-    for (int k = 0; k < W * DP; ++k) offsets_lanes[k] = Real(-(k % W));
-  }
-
-  // Returns false when the particle's stencil leaves the grid.
-  [[gnu::always_inline]] bool build(const ParticleView<D, Real>& P, std::size_t p) {
-    // Lowest xi the stencil allows, and the margin it needs above: linear
-    // [0, n - 1), uGIMP and quadratic [1/2, n - 3/2) (stencil base
-    // floor(xi - 1/2)), cubic [1, n - 2).
-    constexpr Real lo_xi = Shape::W == 2 ? Real(0) : (Shape::S == 3 ? Real(0.5) : Real(1));
-    constexpr Real hi_margin = Shape::W == 2 ? Real(1) : (Shape::S == 3 ? Real(1.5) : Real(2));
-    VA r{}, l{};
-    std::size_t stride = 1;
-    base = 0;
-    for (int d = 0; d < D; ++d) {
-      const Real xi = (P.x[d][p] - origin[d]) * inv_h[d];
-      // Compared in Real before any int conversion (a wild position must not overflow).
-      if (!(xi >= lo_xi && xi < Real(n[d]) - hi_margin)) return false;
-      // Window base: cell - window_lo, moved inward at the grid's edges.
-      const int wb = std::clamp(int(xi) - Shape::window_lo, 0, n[d] - W);
-      r[d] = xi - Real(wb);
-      l[d] = Shape::S == 3 && P.lp[d] ? P.lp[d][p] : Real(0.25);
-      base += std::size_t(wb) * stride;
-      stride *= std::size_t(n[d]);
-    }
-    if constexpr (DP > D)
-      r[DP - 1] = Real(0.5), l[DP - 1] = Real(0.25);  // padding: any harmless distance
-    constexpr auto seq = std::make_index_sequence<W * DP>{};
-    Shape::lanes(spread(r, seq) + offsets_lanes, spread(l, seq), wa, dwa);
-    dwa *= inv_h_lanes;
-    return true;
-  }
-
- private:
-  Real inv_h[D]{}, origin[D]{};
-  int n[D]{};
-  VA inv_h_lanes{}, offsets_lanes{};
-
   // Lane d * W + k = lane d of t.
   template <std::size_t... I>
   static VA spread(const VA& t, std::index_sequence<I...>) {
     return __builtin_shufflevector(t, t, int(I / W)...);
   }
+
+ private:
   // Lanes of a picked by a constexpr index function of the unit lane.
   template <class F, std::size_t... I>
   static V pick_of(const VA& a, F, std::index_sequence<I...>) {
@@ -214,6 +173,64 @@ struct Window {
   static Row row_of(const V& v, std::index_sequence<I...>) {
     return __builtin_shufflevector(v, v, int(k * W + I)...);
   }
+};
+
+// Builds particles' windows on one grid (the grid's constants are kept here,
+// once, not in every Window of a batch, kernels/weight_batch.hpp).
+template <int D, class Shape, class Real>
+class WindowBuilder {
+ public:
+  using Win = Window<D, Shape, Real>;
+  static constexpr int W = Win::W, DP = Win::DP;
+  using VA = typename Win::VA;
+
+  explicit WindowBuilder(const GridView<D, Real>& G) {
+    VA ih{};
+    for (int d = 0; d < DP; ++d) {
+      ih[d] = d < D ? Real(1) / G.h[std::size_t(d)] : Real(1);
+      if (d < D)
+        inv_h[d] = ih[d], origin[d] = G.origin[std::size_t(d)],
+        n[d] = G.nodes_per_dim[std::size_t(d)];
+    }
+    inv_h_lanes = Win::spread(ih, std::make_index_sequence<W * DP>{});
+    for (int k = 0; k < W * DP; ++k) offsets_lanes[k] = Real(-(k % W));
+  }
+
+  // The window of particle p into w; false when the particle's stencil
+  // leaves the grid.
+  [[gnu::always_inline]] bool build(const ParticleView<D, Real>& P, std::size_t p, Win& w) const {
+    // Lowest xi the stencil allows, and the margin it needs above: linear
+    // [0, n - 1), uGIMP and quadratic [1/2, n - 3/2) (stencil base
+    // floor(xi - 1/2)), cubic [1, n - 2).
+    constexpr Real lo_xi = Shape::W == 2 ? Real(0) : (Shape::S == 3 ? Real(0.5) : Real(1));
+    constexpr Real hi_margin = Shape::W == 2 ? Real(1) : (Shape::S == 3 ? Real(1.5) : Real(2));
+    VA r{}, l{};
+    std::size_t stride = 1;
+    std::size_t base = 0;
+    for (int d = 0; d < D; ++d) {
+      const Real xi = (P.x[d][p] - origin[d]) * inv_h[d];
+      // Compared in Real before any int conversion (a wild position must not overflow).
+      if (!(xi >= lo_xi && xi < Real(n[d]) - hi_margin)) return false;
+      // Window base: cell - window_lo, moved inward at the grid's edges.
+      const int wb = std::clamp(int(xi) - Shape::window_lo, 0, n[d] - W);
+      r[d] = xi - Real(wb);
+      l[d] = Shape::S == 3 && P.lp[d] ? P.lp[d][p] : Real(0.25);
+      base += std::size_t(wb) * stride;
+      stride *= std::size_t(n[d]);
+    }
+    if constexpr (DP > D)
+      r[DP - 1] = Real(0.5), l[DP - 1] = Real(0.25);  // padding: any harmless distance
+    constexpr auto seq = std::make_index_sequence<W * DP>{};
+    Shape::lanes(Win::spread(r, seq) + offsets_lanes, Win::spread(l, seq), w.wa, w.dwa);
+    w.dwa *= inv_h_lanes;
+    w.base = base;
+    return true;
+  }
+
+ private:
+  Real inv_h[D]{}, origin[D]{};
+  int n[D]{};
+  VA inv_h_lanes{}, offsets_lanes{};
 };
 
 }  // namespace mmpm

@@ -236,7 +236,7 @@ struct StencilFixture {
   }
   // Weights by absolute node index.
   std::map<std::size_t, Real> weights() const {
-    Stencil<D, Shape, Real> st;
+    Stencil<D, Shape, Real> st{};
     EXPECT_TRUE(st.build(P, G, inv_h, 0));
     std::map<std::size_t, Real> m;
     for (int k = 0; k < st.count; ++k) m[st.base + st.node[k]] = st.w[k];
@@ -257,7 +257,7 @@ void check_stencil(double l, double tol, unsigned seed) {
       while (c0 && near_integer(xi[d], 1e-4));
       f.x[d][0] = Real(double(f.G.origin[d]) + xi[d] * double(f.G.h[d]));
     }
-    Stencil<D, Shape, Real> st;
+    Stencil<D, Shape, Real> st{};
     ASSERT_TRUE(st.build(f.P, f.G, f.inv_h, 0));
     double sw = 0, sg[D] = {}, sx[D] = {}, sgx[D][D] = {};
     for (int k = 0; k < st.count; ++k) {

@@ -65,10 +65,17 @@ class MultimaterialStage {
 
   bool has_interface_forces() const { return enabled_ && has_interface_; }
 
-  void pass_a(GridView<D, Real>& grid, double dt, double /*time*/, long /*step*/) {
+  // The step's multimaterial nodes, from the masses of the first P2G.
+  void find_nodes(const GridView<D, Real>& grid) {
+    if (!enabled_) return;
+    find_multimaterial_nodes(grid, cfg_.mass_threshold, list_);
+  }
+  const std::vector<std::uint32_t>& nodes() const { return list_; }
+
+  // After find_nodes and the multimaterial fields' P2G.
+  void pass_a(GridView<D, Real>& grid, double dt) {
     if (!enabled_) return;
     cfg_.dt = Real(dt);
-    find_multimaterial_nodes(grid, cfg_.mass_threshold, list_);
     stats_.reset(fields_);
     multimaterial_pass_a(grid, list_, cfg_, stats_, stick_flags_);
   }

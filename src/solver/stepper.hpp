@@ -17,6 +17,7 @@
 #include "kernels/g2p.hpp"
 #include "kernels/grid_update.hpp"
 #include "kernels/p2g.hpp"
+#include "kernels/p2g_multimaterial.hpp"
 #include "kernels/reduce.hpp"
 #include "kernels/shape.hpp"
 #include "model/bodies.hpp"
@@ -84,6 +85,9 @@ class Stepper final : public Simulation {
   void zero_grid(bool mm);
   template <unsigned What>
   void p2g(const char* stage_label);
+  // mx, Omega and g (ALGORITHM §1) from the tiles whose particles reach a
+  // multimaterial node, the only nodes where they are read.
+  void p2g_multimaterial();
   template <unsigned What>
   void g2p();
   // G2P that also scatters (kScatterMomentum): tiles color by color, as P2G.
@@ -135,6 +139,7 @@ class Stepper final : public Simulation {
 
   TileLayout<D> tiles_;
   TileSchedule schedule_;  // tile ranges and each thread's tiles per color
+  ReachTiles reach_tiles_;  // tiles reaching a multimaterial node (p2g_multimaterial)
   bool dirty_ = true;
 
   // Per-material particle lists (several materials, constitutive pass unfused).

@@ -140,7 +140,7 @@ void Stepper<D, Shape, Real>::setup_particles(const ParticleSeeds& seeds) {
   mass_threshold_ = Real(1e-9 * min_mass);
   // Check every particle's stencil fits the grid before anything runs.
   const std::array<Real, 3> inv_h{Real(1) / G_.h[0], Real(1) / G_.h[1], Real(1) / G_.h[2]};
-  Stencil<D, Shape, Real> st;
+  Stencil<D, Shape, Real> st{};
   for (std::size_t p = 0; p < n; ++p)
     if (!st.build(P_, G_, inv_h, p))
       throw InputError(located(scene_.source_file, 0, "grid",
@@ -227,13 +227,9 @@ void Stepper<D, Shape, Real>::zero_grid(bool mm) {
   };
   zero(G_.m);
   for (int d = 0; d < D; ++d) zero(G_.p[d]), zero(G_.f[d]);
-  if (mm) {
-    zero(G_.vol);
-    for (int d = 0; d < D; ++d) {
-      zero(G_.mx[d]), zero(G_.fi[d]);
-      if (G_.g[d]) zero(G_.g[d]);
-    }
-  }
+  // vol, mx and g are zeroed where p2g_multimaterial writes them.
+  if (mm)
+    for (int d = 0; d < D; ++d) zero(G_.fi[d]);
 }
 
 template <int D, class Shape, class Real>
@@ -250,24 +246,28 @@ void Stepper<D, Shape, Real>::p2g(const char* label) {
       const std::uint32_t t = schedule_.tiles[c][k];
       const std::size_t b = schedule_.begin[t], e = schedule_.begin[t + 1];
       std::size_t r;
-      if (plan_.multimaterial && domain_gradient_) {
-        constexpr unsigned W = What | ((What & kMultimaterial) ? unsigned(kDomainGradient) : 0u);
-        r = has_traction_ ? p2g_range<D, Shape, Real, W, true, true>(P_, G_, opt, b, e)
-                          : p2g_range<D, Shape, Real, W, true, false>(P_, G_, opt, b, e);
-      } else if (plan_.multimaterial) {
+      if (plan_.multimaterial)
         r = has_traction_ ? p2g_range<D, Shape, Real, What, true, true>(P_, G_, opt, b, e)
                           : p2g_range<D, Shape, Real, What, true, false>(P_, G_, opt, b, e);
-      } else {
-        r = has_traction_
-                ? p2g_range<D, Shape, Real, What & ~unsigned(kMultimaterial), false, true>(
-                      P_, G_, opt, b, e)
-                : p2g_range<D, Shape, Real, What & ~unsigned(kMultimaterial), false, false>(
-                      P_, G_, opt, b, e);
-      }
+      else
+        r = has_traction_ ? p2g_range<D, Shape, Real, What, false, true>(P_, G_, opt, b, e)
+                          : p2g_range<D, Shape, Real, What, false, false>(P_, G_, opt, b, e);
       if (r != e) bad = std::min(bad, r);
     }
   }
   if (bad != SIZE_MAX) fail_particle(label, bad, "its shape-function stencil left the grid");
+}
+
+// kernels/p2g_multimaterial.hpp: mx, vol, g only around multimaterial nodes.
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::p2g_multimaterial() {
+  P2GOptions opt;
+  opt.position_separation = plan_.position_separation;
+  opt.inv_thickness = 1.0 / double(thickness_);
+  const std::size_t bad = p2g_multimaterial_fields<D, Shape, Real>(
+      P_, G_, opt, tiles_, schedule_, mm_.nodes(), domain_gradient_, P_.n >= kParallelMin,
+      reach_tiles_);
+  if (bad != SIZE_MAX) fail_particle("p2g", bad, "its shape-function stencil left the grid");
 }
 
 template <int D, class Shape, class Real>
@@ -535,14 +535,20 @@ void Stepper<D, Shape, Real>::step() {
   tic();
   zero_grid(mm);
   if (scheme == Scheme::USF)
-    p2g<kMassMomentum | kMultimaterial>("p2g");
+    p2g<kMassMomentum>("p2g");
   else
-    p2g<kMassMomentum | kForce | kMultimaterial>("p2g");
+    p2g<kMassMomentum | kForce>("p2g");
   toc(kStageP2G);
 
   if (mm) {
     tic();
-    mm_.pass_a(G_, dt_, time_, step_);
+    mm_.find_nodes(G_);
+    toc(kStageMultimaterial);
+    tic();
+    p2g_multimaterial();
+    toc(kStageP2G);
+    tic();
+    mm_.pass_a(G_, dt_);
     toc(kStageMultimaterial);
   }
 
