@@ -5,6 +5,10 @@
 //                     [[interaction]] interface, Dn perfect, Dt 5, specified
 //                     normal [1,0], 250 000 particles (the paper's two-layer)
 //   3d_gimp_1mat      3D gimp, one elastic material, 101 376 particles
+//   2d_gimp_inclusions 2D gimp, 625 glass disks in a polymer block, interface
+//                     (inclusions_scene); with mm_fields_share = 1 (fields
+//                     always apart), and the two-layer scene with 0 (always
+//                     with the first P2G)
 // "Unused feature costs nothing" (same geometry, loads and supports as the
 // two-layer scene):
 //   2d_gimp_1mat      both boxes of one material (the baseline)
@@ -139,6 +143,70 @@ traction = [0.0, 0.5]
   return s;
 }
 
+// 2d_gimp_inclusions: a polymer block (250 x 250 mm, 2 x 2 particles per
+// 1 mm cell) holding 625 glass disks of radius 3 mm on a 10 mm pitch, an
+// imperfect interface (Dn = Dt = 1e4, mvg normal: g is scattered too),
+// vibrating (initial velocity, fixed face). Nearly every tile reaches an
+// interface: the case where the multimaterial fields are best scattered
+// with the first P2G ([simulation] mm_fields_share).
+std::string inclusions_scene() {
+  std::string s = R"(
+[simulation]
+dimension = 2
+plane     = "strain"
+thickness = 1.0
+end_time  = 1.0
+cfl       = 0.4
+
+[grid]
+origin = [0.0, 0.0]
+cell   = [1.0, 1.0]
+cells  = [254, 254]
+shape  = "gimp"
+
+[[material]]
+name    = "polymer"
+type    = "isotropic"
+density = 1.2e-3
+E       = 2400.0
+nu      = 0.33
+
+[[material]]
+name    = "glass"
+type    = "isotropic"
+density = 2.5e-3
+E       = 70000.0
+nu      = 0.22
+
+[[body]]
+name     = "block"
+material = "polymer"
+shape    = "box"
+min      = [2.0, 2.0]
+max      = [252.0, 252.0]
+particles_per_cell = 2
+velocity = [0.5, 0.0]
+)";
+  for (int i = 0; i < 25; ++i)
+    for (int j = 0; j < 25; ++j)
+      s += "\n[[body]]\nname = \"disk" + std::to_string(25 * i + j) +
+           "\"\nmaterial = \"glass\"\nshape = \"disk\"\ncenter = [" +
+           std::to_string(7.0 + 10.0 * i) + ", " + std::to_string(7.0 + 10.0 * j) +
+           "]\nradius = 3.0\nparticles_per_cell = 2\n";
+  return s + R"(
+[[interaction]]
+materials = ["glass", "polymer"]
+law       = "interface"
+Dn        = 1.0e4
+Dt        = 1.0e4
+normal    = "mvg"
+
+[[boundary]]
+where = { x = 2.0 }
+fix   = ["x"]
+)";
+}
+
 struct StepCase {
   std::string scene;  // name used in the benchmark name and the fixture key
   std::string text;
@@ -256,6 +324,16 @@ void register_step() {
         threads);
     add({"2d_gimp_interface", two_layer(true, true), {"simulation.fuse_constitutive=true"}},
         threads);
+  }
+  // Multimaterial fields apart (default for the two-layer scene) or with
+  // the first P2G (default for the inclusions), each against the other
+  // choice forced, interleaved.
+  const StepCase inclusions{"2d_gimp_inclusions", inclusions_scene(), {}};
+  for (int threads : {1, 2}) {
+    add({"2d_gimp_interface", two_layer(true, true), {"simulation.mm_fields_share=0.0"}},
+        threads);
+    add(inclusions, threads);
+    add({"2d_gimp_inclusions", inclusions_scene(), {"simulation.mm_fields_share=1.0"}}, threads);
   }
   for (int threads : {1, 2}) add(gimp3d, threads);
   // The unused-feature pair, interleaved.

@@ -32,25 +32,37 @@ struct ReachTiles {
   std::array<std::vector<std::uint32_t>, 8> tiles;  // those tiles, per color, in order
 };
 
-// Scatters mx, vol (and g when with_gradient) from the particles of every
-// tile of `schedule` that reaches one of `nodes` (one field's node indices).
-// Tiles of one color run in parallel when `parallel`. Returns the first
-// particle whose stencil left the grid, or SIZE_MAX.
+// Flags the tiles of `schedule` that reach one of `nodes` (one field's node
+// indices) and lists them per color; returns how many particles they hold.
 template <int D, class Shape, class Real>
-std::size_t p2g_multimaterial_fields(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
-                                     const P2GOptions& opt, const TileLayout<D>& layout,
-                                     const TileSchedule& schedule,
-                                     const std::vector<std::uint32_t>& nodes, bool with_gradient,
-                                     bool parallel, ReachTiles& reach_tiles) {
-  const NodeReach reach = NodeReach::of<Shape>();
+std::size_t find_reach_tiles(const GridView<D, Real>& G, const TileLayout<D>& layout,
+                             const TileSchedule& schedule,
+                             const std::vector<std::uint32_t>& nodes, ReachTiles& reach_tiles) {
   reach_tiles.flag.assign(layout.tile_count, 0);
-  mark_tiles_reaching(layout, G.nodes_per_dim, reach, nodes.data(), nodes.size(),
+  mark_tiles_reaching(layout, G.nodes_per_dim, NodeReach::of<Shape>(), nodes.data(), nodes.size(),
                       reach_tiles.flag);
+  std::size_t particles = 0;
   for (std::size_t c = 0; c < reach_tiles.tiles.size(); ++c) {
     reach_tiles.tiles[c].clear();
     for (const std::uint32_t t : schedule.tiles[c])
-      if (reach_tiles.flag[t]) reach_tiles.tiles[c].push_back(t);
+      if (reach_tiles.flag[t]) {
+        reach_tiles.tiles[c].push_back(t);
+        particles += schedule.begin[t + 1] - schedule.begin[t];
+      }
   }
+  return particles;
+}
+
+// Scatters mx, vol (and g when with_gradient) from the particles of the
+// tiles find_reach_tiles listed, into their node boxes zeroed first. Tiles
+// of one color run in parallel when `parallel`. Returns the first particle
+// whose stencil left the grid, or SIZE_MAX.
+template <int D, class Shape, class Real>
+std::size_t p2g_multimaterial_fields(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
+                                     const P2GOptions& opt, const TileLayout<D>& layout,
+                                     const TileSchedule& schedule, const ReachTiles& reach_tiles,
+                                     bool with_gradient, bool parallel) {
+  const NodeReach reach = NodeReach::of<Shape>();
   // Zero the boxes the scatter adds into: all colors first (boxes of tiles
   // of different colors overlap); tiles of one color have disjoint boxes.
   for (const auto& list : reach_tiles.tiles) {

@@ -538,7 +538,8 @@ class SceneReader {
   // -------------------------------------------------------- [simulation]
   void read_simulation(const Table& t) {
     t.only({"name", "dimension", "plane", "thickness", "end_time", "cfl", "dt", "scheme", "flip",
-            "precision", "default_law", "force", "sort_every", "fuse_constitutive"});
+            "precision", "default_law", "force", "sort_every", "fuse_constitutive",
+            "mm_fields_share"});
     SimulationSpec& sim = scene_.simulation;
     const Field d = t.need("dimension");
     const long long dimension = d.integer();
@@ -574,6 +575,11 @@ class SceneReader {
     if (auto f = t.get("force")) sim.force = f->boolean();
     if (auto f = t.get("sort_every")) sim.sort_every = f->int_at_least(0);
     if (auto f = t.get("fuse_constitutive")) sim.fuse_constitutive = f->boolean();
+    if (auto f = t.get("mm_fields_share")) {
+      sim.mm_fields_share = f->number();
+      if (sim.mm_fields_share < 0 || sim.mm_fields_share > 1)
+        f->fail("expected a number in [0, 1], got " + format_number(sim.mm_fields_share));
+    }
     scene_.name = default_name_;
     if (auto f = t.get("name")) scene_.name = scene_name_value(*f);
   }

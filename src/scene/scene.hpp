@@ -54,6 +54,12 @@ struct SimulationSpec {
   // default: measured slower for 2D linear and no faster for 2D uGIMP
   // (docs/performance.md, "Fusing the constitutive update").
   bool fuse_constitutive = false;
+  // The multimaterial fields (mx, Omega, g) are scattered apart, only from
+  // tiles that reach a multimaterial node, unless more than this share of
+  // the particles sits in such tiles (then with the first P2G). The values
+  // at multimaterial nodes are the same either way (docs/performance.md,
+  // "Multimaterial fields where they are read").
+  double mm_fields_share = 0.5;
   Where step_where;  // where the time step was set (cfl or dt), for messages
 };
 

@@ -35,6 +35,9 @@ struct StepCounters {
   long multimaterial_nodes = 0;
   long nodes_3plus = 0;
   long force_limited_nodes = 0;
+  // The last step scattered mx, Omega, g with its first P2G (else apart,
+  // from the tiles reaching a multimaterial node; [simulation] mm_fields_share).
+  bool mm_fields_with_p2g = false;
 };
 
 struct Reaction {

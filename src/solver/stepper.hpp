@@ -49,7 +49,11 @@ class Stepper final : public Simulation {
   int field_count() const override { return plan_.fields; }
   int tile_edge() const override { return tiles_.T; }
   Energies energies() const override;
-  StepCounters counters() const override { return mm_.counters(); }
+  StepCounters counters() const override {
+    StepCounters c = mm_.counters();
+    c.mm_fields_with_p2g = mm_fields_scattered_with_p2g_;
+    return c;
+  }
   std::vector<Reaction> reactions() const override;
   io::ParticleField particle_field(const std::string& name) const override;
   io::Snapshot snapshot(const std::vector<std::string>& fields) const override;
@@ -86,7 +90,8 @@ class Stepper final : public Simulation {
   template <unsigned What>
   void p2g(const char* stage_label);
   // mx, Omega and g (ALGORITHM §1) from the tiles whose particles reach a
-  // multimaterial node, the only nodes where they are read.
+  // multimaterial node, the only nodes where they are read (or nothing, when
+  // the first P2G scattered them).
   void p2g_multimaterial();
   template <unsigned What>
   void g2p();
@@ -140,6 +145,10 @@ class Stepper final : public Simulation {
   TileLayout<D> tiles_;
   TileSchedule schedule_;  // tile ranges and each thread's tiles per color
   ReachTiles reach_tiles_;  // tiles reaching a multimaterial node (p2g_multimaterial)
+  // This step's first P2G also scatters mx, vol, g (chosen from the share of
+  // particles the previous step's multimaterial nodes reached).
+  bool mm_fields_with_p2g_ = false;
+  bool mm_fields_scattered_with_p2g_ = false;  // what the last step did
   bool dirty_ = true;
 
   // Per-material particle lists (several materials, constitutive pass unfused).

@@ -227,9 +227,14 @@ void Stepper<D, Shape, Real>::zero_grid(bool mm) {
   };
   zero(G_.m);
   for (int d = 0; d < D; ++d) zero(G_.p[d]), zero(G_.f[d]);
-  // vol, mx and g are zeroed where p2g_multimaterial writes them.
-  if (mm)
-    for (int d = 0; d < D; ++d) zero(G_.fi[d]);
+  if (!mm) return;
+  for (int d = 0; d < D; ++d) zero(G_.fi[d]);
+  if (!mm_fields_with_p2g_) return;  // else p2g_multimaterial zeroes what it writes
+  zero(G_.vol);
+  for (int d = 0; d < D; ++d) {
+    zero(G_.mx[d]);
+    if (G_.g[d]) zero(G_.g[d]);
+  }
 }
 
 template <int D, class Shape, class Real>
@@ -246,7 +251,11 @@ void Stepper<D, Shape, Real>::p2g(const char* label) {
       const std::uint32_t t = schedule_.tiles[c][k];
       const std::size_t b = schedule_.begin[t], e = schedule_.begin[t + 1];
       std::size_t r;
-      if (plan_.multimaterial)
+      if (plan_.multimaterial && domain_gradient_) {
+        constexpr unsigned W = What | ((What & kMultimaterial) ? unsigned(kDomainGradient) : 0u);
+        r = has_traction_ ? p2g_range<D, Shape, Real, W, true, true>(P_, G_, opt, b, e)
+                          : p2g_range<D, Shape, Real, W, true, false>(P_, G_, opt, b, e);
+      } else if (plan_.multimaterial)
         r = has_traction_ ? p2g_range<D, Shape, Real, What, true, true>(P_, G_, opt, b, e)
                           : p2g_range<D, Shape, Real, What, true, false>(P_, G_, opt, b, e);
       else
@@ -258,15 +267,27 @@ void Stepper<D, Shape, Real>::p2g(const char* label) {
   if (bad != SIZE_MAX) fail_particle(label, bad, "its shape-function stencil left the grid");
 }
 
-// kernels/p2g_multimaterial.hpp: mx, vol, g only around multimaterial nodes.
+// kernels/p2g_multimaterial.hpp: mx, vol, g only from the tiles that reach
+// a multimaterial node, unless this step scattered them with the first P2G.
+// Either way the values at multimaterial nodes are the same (bitwise,
+// tests/test_p2g.cpp, tests/test_multimaterial_fields.cpp), so the choice
+// changes no result. Scattering them apart costs the reaching tiles'
+// particles a second window build, so when those are more than
+// [simulation] mm_fields_share of the particles (fields mixed everywhere:
+// many small inclusions) the next step scatters them with the first P2G.
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::p2g_multimaterial() {
+  const std::size_t reaching =
+      find_reach_tiles<D, Shape, Real>(G_, tiles_, schedule_, mm_.nodes(), reach_tiles_);
+  const bool scattered = mm_fields_with_p2g_;
+  mm_fields_scattered_with_p2g_ = scattered;
+  mm_fields_with_p2g_ = double(reaching) > scene_.simulation.mm_fields_share * double(P_.n);
+  if (scattered) return;
   P2GOptions opt;
   opt.position_separation = plan_.position_separation;
   opt.inv_thickness = 1.0 / double(thickness_);
   const std::size_t bad = p2g_multimaterial_fields<D, Shape, Real>(
-      P_, G_, opt, tiles_, schedule_, mm_.nodes(), domain_gradient_, P_.n >= kParallelMin,
-      reach_tiles_);
+      P_, G_, opt, tiles_, schedule_, reach_tiles_, domain_gradient_, P_.n >= kParallelMin);
   if (bad != SIZE_MAX) fail_particle("p2g", bad, "its shape-function stencil left the grid");
 }
 
@@ -534,10 +555,12 @@ void Stepper<D, Shape, Real>::step() {
 
   tic();
   zero_grid(mm);
+  const unsigned with_mm = mm && mm_fields_with_p2g_ ? unsigned(kMultimaterial) : 0u;
   if (scheme == Scheme::USF)
-    p2g<kMassMomentum>("p2g");
+    with_mm ? p2g<kMassMomentum | kMultimaterial>("p2g") : p2g<kMassMomentum>("p2g");
   else
-    p2g<kMassMomentum | kForce>("p2g");
+    with_mm ? p2g<kMassMomentum | kForce | kMultimaterial>("p2g")
+            : p2g<kMassMomentum | kForce>("p2g");
   toc(kStageP2G);
 
   if (mm) {
