@@ -322,8 +322,7 @@ void register_step() {
   // choice forced, interleaved.
   const StepCase inclusions{"2d_gimp_inclusions", inclusions_scene(), {}};
   for (int threads : {1, 2}) {
-    add({"2d_gimp_interface", two_layer(true, true), {"simulation.mm_fields_share=0.0"}},
-        threads);
+    add({"2d_gimp_interface", two_layer(true, true), {"simulation.mm_fields_share=0.0"}}, threads);
     add(inclusions, threads);
     add({"2d_gimp_inclusions", inclusions_scene(), {"simulation.mm_fields_share=1.0"}}, threads);
   }

@@ -161,8 +161,8 @@ struct PositionTile {
     for (std::size_t p = begin; p < end; ++p) {
       std::uint32_t t = 0, stride = 1;
       for (int d = 0; d < D; ++d) {
-        int c = int(std::floor((x[std::size_t(d)][p] - origin[std::size_t(d)]) *
-                               inv_h[std::size_t(d)]));
+        int c = int(
+            std::floor((x[std::size_t(d)][p] - origin[std::size_t(d)]) * inv_h[std::size_t(d)]));
         c = c < 0 ? 0 : (c >= tiles.cells[std::size_t(d)] ? tiles.cells[std::size_t(d)] - 1 : c);
         t += std::uint32_t(c >> tiles.shift) * stride;
         stride *= std::uint32_t(tiles.tiles[std::size_t(d)]);

@@ -84,8 +84,7 @@ struct G2PGather {
   // vn, dv: velocity and its change over the step; L row-major dv_a/dx_b.
   template <bool Motion, bool Gradient>
   [[gnu::always_inline]] void gather(const Weights& w, const GridVelocity<D, Real>& V,
-                                     std::size_t field_offset, Real* vn, Real* dv,
-                                     Real* L) const {
+                                     std::size_t field_offset, Real* vn, Real* dv, Real* L) const {
     const std::size_t b = w.base + field_offset;
     if constexpr (!Windowed) {
       for (int k = 0; k < St::count; ++k) {
@@ -176,7 +175,7 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
       Windowed ? Window<D, Shape, Real>::offsets(G) : typename Window<D, Shape, Real>::Offsets{};
   using Weights = typename G2PGather<D, Shape, Real, Windowed>::Weights;
   auto scatter_momentum = [&](const Weights& w, std::size_t p, std::size_t fo)
-                              __attribute__((always_inline)) {
+      __attribute__((always_inline)) {
     ScatterSource<D, Real> s;
     for (int d = 0; d < D; ++d) s.mv[d] = P.m[p] * P.v[d][p];
     if constexpr (Windowed) {
@@ -189,7 +188,9 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
       }
     }
   };
-  auto build = [&](std::size_t p, Weights& w) __attribute__((always_inline)) { return st.build(P, p, w); };
+  auto build = [&](std::size_t p, Weights & w) __attribute__((always_inline)) {
+    return st.build(P, p, w);
+  };
   auto transfer = [&](std::size_t p, const Weights* weights) __attribute__((always_inline)) {
     if (!weights) {
       if (r.bad == SIZE_MAX) r.bad = p;

@@ -522,12 +522,23 @@ void run_pass(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
 #pragma omp parallel if (n >= kParallelNodes)
   {
     NodeFields<D, Real> nf;
+    // A chunk's statistics are summed in the thread's own copy and stored
+    // once per chunk: neighbouring chunks' entries share cache lines, and
+    // updating them node by node from two threads made the pass slower on
+    // 2 threads than on 1 (bench 2d_gimp_inclusions, 22 000 nodes: 0.8x).
+    std::vector<double> reaction(reaction_stride);
 #pragma omp for schedule(dynamic, 1)
     for (std::size_t c = 0; c < chunks; ++c) {
+      ChunkStats local;
+      std::fill(reaction.begin(), reaction.end(), 0.0);
+      local.reaction = reaction.data();
       const std::size_t end = std::min(n, (c + 1) * kChunk);
       for (std::size_t k = c * kChunk; k < end; ++k)
         process_node<D, Real, kPassA>(grid, cfg, k, list[k], needs, nf, flags_in, flags_out,
-                                      partial[c]);
+                                      local);
+      local.reaction = partial[c].reaction;
+      std::copy(reaction.begin(), reaction.end(), local.reaction);
+      partial[c] = local;
     }
   }
 

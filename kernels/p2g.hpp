@@ -100,7 +100,9 @@ std::size_t p2g_range(const ParticleView<D, Real>& particles, const GridView<D, 
   const auto off = Win::offsets(G);
   Block block;
   const WindowBuilder<D, Shape, Real> builder(G);
-  auto build = [&](std::size_t p, Win& w) __attribute__((always_inline)) { return builder.build(P, p, w); };
+  auto build = [&](std::size_t p, Win & w) __attribute__((always_inline)) {
+    return builder.build(P, p, w);
+  };
   auto scatter = [&](std::size_t p, const Win* win) __attribute__((always_inline)) {
     if (!win) return false;
     block.at(win->base + (MultiField ? std::size_t(P.field[p]) * G.nodes : 0), G, off);

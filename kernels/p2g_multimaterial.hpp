@@ -28,7 +28,7 @@ namespace mmpm {
 
 // Scratch of the pass, kept between steps (no allocation once warm).
 struct ReachTiles {
-  std::vector<std::uint8_t> flag;                  // per tile: reaches a listed node
+  std::vector<std::uint8_t> flag;                   // per tile: reaches a listed node
   std::array<std::vector<std::uint32_t>, 8> tiles;  // those tiles, per color, in order
 };
 
@@ -36,8 +36,8 @@ struct ReachTiles {
 // indices) and lists them per color; returns how many particles they hold.
 template <int D, class Shape, class Real>
 std::size_t find_reach_tiles(const GridView<D, Real>& G, const TileLayout<D>& layout,
-                             const TileSchedule& schedule,
-                             const std::vector<std::uint32_t>& nodes, ReachTiles& reach_tiles) {
+                             const TileSchedule& schedule, const std::vector<std::uint32_t>& nodes,
+                             ReachTiles& reach_tiles) {
   reach_tiles.flag.assign(layout.tile_count, 0);
   mark_tiles_reaching(layout, G.nodes_per_dim, NodeReach::of<Shape>(), nodes.data(), nodes.size(),
                       reach_tiles.flag);
@@ -82,10 +82,9 @@ std::size_t p2g_multimaterial_fields(const ParticleView<D, Real>& P, const GridV
     for (std::size_t k = 0; k < list.size(); ++k) {
       const std::size_t b = schedule.begin[list[k]], e = schedule.begin[list[k] + 1];
       const std::size_t r =
-          with_gradient
-              ? p2g_range<D, Shape, Real, kMultimaterial | kDomainGradient, true, false>(P, G, opt,
-                                                                                         b, e)
-              : p2g_range<D, Shape, Real, kMultimaterial, true, false>(P, G, opt, b, e);
+          with_gradient ? p2g_range<D, Shape, Real, kMultimaterial | kDomainGradient, true, false>(
+                              P, G, opt, b, e)
+                        : p2g_range<D, Shape, Real, kMultimaterial, true, false>(P, G, opt, b, e);
       if (r != e) bad = std::min(bad, r);
     }
   }

@@ -27,19 +27,19 @@ namespace {
 
 using namespace mmpm;
 
-std::string inclusions(const std::string& scheme, const std::string& interaction,
-                       double share) {
-  std::string s = "[simulation]\ndimension = 2\nplane = \"strain\"\nend_time = 1.0\ncfl = 0.4\n"
-                  "scheme = \"" +
-                  scheme + "\"\nmm_fields_share = " + std::to_string(share) +
-                  "\n\n[grid]\norigin = [0.0, 0.0]\ncell = [1.0, 1.0]\ncells = [56, 56]\n"
-                  "shape = \"gimp\"\n\n"
-                  "[[material]]\nname = \"polymer\"\ntype = \"isotropic\"\ndensity = 1.2e-3\n"
-                  "E = 2400.0\nnu = 0.33\n\n"
-                  "[[material]]\nname = \"glass\"\ntype = \"isotropic\"\ndensity = 2.5e-3\n"
-                  "E = 70000.0\nnu = 0.22\n\n"
-                  "[[body]]\nname = \"block\"\nmaterial = \"polymer\"\nshape = \"box\"\n"
-                  "min = [4.0, 4.0]\nmax = [52.0, 52.0]\nparticles_per_cell = 2\n";
+std::string inclusions(const std::string& scheme, const std::string& interaction, double share) {
+  std::string s =
+      "[simulation]\ndimension = 2\nplane = \"strain\"\nend_time = 1.0\ncfl = 0.4\n"
+      "scheme = \"" +
+      scheme + "\"\nmm_fields_share = " + std::to_string(share) +
+      "\n\n[grid]\norigin = [0.0, 0.0]\ncell = [1.0, 1.0]\ncells = [56, 56]\n"
+      "shape = \"gimp\"\n\n"
+      "[[material]]\nname = \"polymer\"\ntype = \"isotropic\"\ndensity = 1.2e-3\n"
+      "E = 2400.0\nnu = 0.33\n\n"
+      "[[material]]\nname = \"glass\"\ntype = \"isotropic\"\ndensity = 2.5e-3\n"
+      "E = 70000.0\nnu = 0.22\n\n"
+      "[[body]]\nname = \"block\"\nmaterial = \"polymer\"\nshape = \"box\"\n"
+      "min = [4.0, 4.0]\nmax = [52.0, 52.0]\nparticles_per_cell = 2\n";
   for (int i = 0; i < 4; ++i)
     for (int j = 0; j < 4; ++j)
       s += "\n[[body]]\nname = \"disk" + std::to_string(4 * i + j) +

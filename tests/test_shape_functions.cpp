@@ -37,9 +37,9 @@ struct Case {
 };
 
 using LinearCase = Case<LinearShape>;
-using Gimp4Case = Case<GimpShape, 4>;   // l = 0.25  (2 particles per cell)
-using Gimp8Case = Case<GimpShape, 8>;   // l = 0.125 (4 particles per cell)
-using Gimp2Case = Case<GimpShape, 2>;   // l = 0.5   (1 particle per cell)
+using Gimp4Case = Case<GimpShape, 4>;  // l = 0.25  (2 particles per cell)
+using Gimp8Case = Case<GimpShape, 8>;  // l = 0.125 (4 particles per cell)
+using Gimp2Case = Case<GimpShape, 2>;  // l = 0.5   (1 particle per cell)
 using BSpline2Case = Case<BSpline2Shape>;
 using BSpline3Case = Case<BSpline3Shape>;
 
@@ -68,7 +68,9 @@ Real weight_of_node(Real xi, Real l, int j) {
   return j >= base && j < base + Shape::S ? w[j - base] : Real(0);
 }
 
-bool near_integer(double x, double tol) { return std::abs(x - std::round(x)) < tol; }
+bool near_integer(double x, double tol) {
+  return std::abs(x - std::round(x)) < tol;
+}
 
 template <class Shape, class Real>
 void check_1d(double l, double tol, int points, unsigned seed) {
@@ -139,8 +141,9 @@ TYPED_TEST(ShapeFunctions, DerivativeIsFiniteDifferenceOfWeight) {
     double w[S::S], dw[S::S];
     const int base = S::eval(xi, l, w, dw);
     for (int k = 0; k < S::S; ++k) {
-      const double fd = (weight_of_node<S>(xi + e, l, base + k) - weight_of_node<S>(xi - e, l, base + k)) /
-                        (2 * e);
+      const double fd =
+          (weight_of_node<S>(xi + e, l, base + k) - weight_of_node<S>(xi - e, l, base + k)) /
+          (2 * e);
       ASSERT_NEAR(dw[k], fd, 1e-6) << "xi=" << xi << " node " << base + k;
       // The weight itself is continuous across the stencil switch.
       ASSERT_NEAR(weight_of_node<S>(xi + e, l, base + k), w[k], 1e-6);
@@ -159,12 +162,18 @@ double hat_integral(double x) {
   if (x <= 1) return 1 - 0.5 * (1 - x) * (1 - x);
   return 1;
 }
-double hat(double x) { return std::max(0.0, 1 - std::abs(x)); }
+double hat(double x) {
+  return std::max(0.0, 1 - std::abs(x));
+}
 
 // uGIMP weight of a node at distance d (cell units) from a particle of half-width l:
 // (1/2l) * integral of N over [d - l, d + l]; its derivative in d by Leibniz' rule.
-double ugimp_weight(double d, double l) { return (hat_integral(d + l) - hat_integral(d - l)) / (2 * l); }
-double ugimp_derivative(double d, double l) { return (hat(d + l) - hat(d - l)) / (2 * l); }
+double ugimp_weight(double d, double l) {
+  return (hat_integral(d + l) - hat_integral(d - l)) / (2 * l);
+}
+double ugimp_derivative(double d, double l) {
+  return (hat(d + l) - hat(d - l)) / (2 * l);
+}
 
 TEST(ShapeFunctions, GimpWeightEqualsAnalyticIntegralHandValues) {
   struct Hand {
@@ -287,7 +296,8 @@ void check_stencil(double l, double tol, unsigned seed) {
         f.x[d][0] = x0;
         for (int k = 0; k < st.count; ++k) {
           const std::size_t node = st.base + st.node[k];
-          const double a = wp.count(node) ? wp.at(node) : 0.0, b = wm.count(node) ? wm.at(node) : 0.0;
+          const double a = wp.count(node) ? wp.at(node) : 0.0,
+                       b = wm.count(node) ? wm.at(node) : 0.0;
           ASSERT_NEAR(double(st.g[k][d]), (a - b) / (2 * e), 1e-6 * double(f.inv_h[d]))
               << D << "D gradient component " << d << " at node " << node;
         }

@@ -741,7 +741,8 @@ class SceneReader {
 
   // -------------------------------------------------------------- [[body]]
   static Keys body_keys(BodyShape shape) {
-    Keys keys{"name", "material", "shape", "rotate", "pivot", "particles_per_cell", "velocity", "clip"};
+    Keys keys{"name",  "material",           "shape",    "rotate",
+              "pivot", "particles_per_cell", "velocity", "clip"};
     switch (shape) {
       case BodyShape::box:
         keys.insert(keys.end(), {"min", "max"});

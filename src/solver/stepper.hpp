@@ -143,7 +143,7 @@ class Stepper final : public Simulation {
   std::vector<std::uint32_t> perm_, offsets_, scratch_keys_;
 
   TileLayout<D> tiles_;
-  TileSchedule schedule_;  // tile ranges and each thread's tiles per color
+  TileSchedule schedule_;   // tile ranges and each thread's tiles per color
   ReachTiles reach_tiles_;  // tiles reaching a multimaterial node (p2g_multimaterial)
   // This step's first P2G also scatters mx, vol, g (chosen from the share of
   // particles the previous step's multimaterial nodes reached).
