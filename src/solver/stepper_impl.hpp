@@ -555,12 +555,19 @@ void Stepper<D, Shape, Real>::step() {
 
   tic();
   zero_grid(mm);
-  const unsigned with_mm = mm && mm_fields_with_p2g_ ? unsigned(kMultimaterial) : 0u;
-  if (scheme == Scheme::USF)
-    with_mm ? p2g<kMassMomentum | kMultimaterial>("p2g") : p2g<kMassMomentum>("p2g");
-  else
-    with_mm ? p2g<kMassMomentum | kForce | kMultimaterial>("p2g")
-            : p2g<kMassMomentum | kForce>("p2g");
+  // mx, Omega, g with this P2G only when p2g_multimaterial chose so.
+  const bool with_mm = mm && mm_fields_with_p2g_;
+  if (scheme == Scheme::USF) {
+    if (with_mm)
+      p2g<kMassMomentum | kMultimaterial>("p2g");
+    else
+      p2g<kMassMomentum>("p2g");
+  } else {
+    if (with_mm)
+      p2g<kMassMomentum | kForce | kMultimaterial>("p2g");
+    else
+      p2g<kMassMomentum | kForce>("p2g");
+  }
   toc(kStageP2G);
 
   if (mm) {
