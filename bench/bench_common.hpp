@@ -290,18 +290,11 @@ struct Binning {
   void permute(ParticleSet<D, Real>& S) {
     const std::size_t n = S.P.n;
     scratch.resize(n);
-    for (auto& col : S.reals) {
-      gather_permute(col.data(), scratch.data(), perm.data(), n);
-      std::memcpy(col.data(), scratch.data(), n * sizeof(Real));
-    }
+    for (auto& col : S.reals) permute_in_place(col.data(), scratch.data(), perm.data(), n);
     scratch_bytes.resize(n);
-    for (auto& col : S.bytes) {
-      gather_permute(col.data(), scratch_bytes.data(), perm.data(), n);
-      std::memcpy(col.data(), scratch_bytes.data(), n);
-    }
+    for (auto& col : S.bytes) permute_in_place(col.data(), scratch_bytes.data(), perm.data(), n);
     scratch_keys.resize(n);
-    gather_permute(S.P.key, scratch_keys.data(), perm.data(), n);
-    std::memcpy(S.P.key, scratch_keys.data(), n * sizeof(std::uint32_t));
+    permute_in_place(S.P.key, scratch_keys.data(), perm.data(), n);
   }
   void rebuild_ranges(const ParticleSet<D, Real>& S) {
     schedule.build(tiles, S.P.key, S.P.n);

@@ -8,11 +8,14 @@
 // T >= 3 keeps same-colored tiles on disjoint nodes.
 #pragma once
 
+#include <omp.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <utility>
 #include <vector>
 
@@ -185,11 +188,24 @@ inline void counting_sort(const std::uint32_t* key, std::size_t n, std::uint32_t
   for (std::size_t p = 0; p < n; ++p) perm[next[key[p]]++] = std::uint32_t(p);
 }
 
-// out[i] = in[perm[i]] for one array; parallel and race-free.
+// a[i] <- a[perm[i]] for one array, through `scratch` (n entries). Each
+// thread gathers its static block into scratch and, after all have
+// gathered, copies the same block back: the array's block then ends in the
+// cache of the thread whose particle loops use it (schedule(static),
+// kernels/node_ownership.hpp explains why that matters on this machine).
+// A serial copy-back left half of every column in the other core's cache
+// and made the 2-thread sort slower than the 1-thread one.
 template <class T>
-inline void gather_permute(const T* in, T* out, const std::uint32_t* perm, std::size_t n) {
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (std::size_t i = 0; i < n; ++i) out[i] = in[perm[i]];
+inline void permute_in_place(T* __restrict a, T* __restrict scratch,
+                             const std::uint32_t* __restrict perm, std::size_t n) {
+#pragma omp parallel if (n >= kParallelMin)
+  {
+    const auto [b, e] =
+        thread_block(n, std::size_t(omp_get_num_threads()), std::size_t(omp_get_thread_num()));
+    for (std::size_t i = b; i < e; ++i) scratch[i] = a[perm[i]];
+#pragma omp barrier
+    if (e > b) std::memcpy(a + b, scratch + b, (e - b) * sizeof(T));
+  }
 }
 
 }  // namespace mmpm

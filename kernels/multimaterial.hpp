@@ -10,11 +10,13 @@
 //                             momenta, stick re-applied where stick_flags say so
 //
 // Every node of the list is independent (it writes only its own grid entries), so the
-// node loop runs in parallel; statistics are summed per fixed chunk of the list and the
+// node loop runs in parallel, each thread on the nodes it owns first
+// (kernels/node_ownership.hpp); statistics are summed per fixed chunk of the list and the
 // chunks are added in order, so results do not depend on the number of threads.
 #pragma once
 
 #include <algorithm>
+#include <atomic>
 #include <cassert>
 #include <cstdint>
 #include <utility>
@@ -25,7 +27,7 @@
 #include "kernels/mm_contact.hpp"
 #include "kernels/mm_interface.hpp"
 #include "kernels/mm_normals.hpp"
-#include "kernels/reduce.hpp"
+#include "kernels/node_ownership.hpp"
 
 namespace mmpm {
 
@@ -93,9 +95,11 @@ const char* validate_multimaterial(const GridView<D, Real>& grid, const MMConfig
 }
 
 // Nodes where at least two fields have m > mass_threshold, in ascending order.
+// Blocks of nodes are counted and listed by the thread that owns them
+// (kernels/node_ownership.hpp); the list does not depend on who did which.
 template <int D, class Real>
 void find_multimaterial_nodes(const GridView<D, Real>& grid, Real mass_threshold,
-                              std::vector<std::uint32_t>& list) {
+                              std::vector<std::uint32_t>& list, const NodeOwnership& own = {}) {
   const std::size_t nodes = grid.nodes;
   const int F = grid.fields;
   if (F < 2 || !grid.m || nodes == 0) {
@@ -106,30 +110,34 @@ void find_multimaterial_nodes(const GridView<D, Real>& grid, Real mass_threshold
   const std::size_t blocks = (nodes + kBlock - 1) / kBlock;
   std::vector<std::size_t> offset(blocks + 1, 0);
   const Real* m = grid.m;
+  auto present = [&](std::size_t i) {
+    int count = 0;
+    for (int f = 0; f < F; ++f) count += m[std::size_t(f) * nodes + i] > mass_threshold;
+    return count >= 2;
+  };
 
-#pragma omp parallel for schedule(static) if (nodes >= kParallelMin)
-  for (std::size_t b = 0; b < blocks; ++b) {
-    const std::size_t end = std::min(nodes, (b + 1) * kBlock);
-    std::size_t count = 0;
+#pragma omp parallel if (nodes >= kParallelMin)
+  {
+    const auto [b0, b1] = own.chunks(nodes, kBlock, std::size_t(omp_get_num_threads()),
+                                     std::size_t(omp_get_thread_num()));
+    for (std::size_t b = b0; b < b1; ++b) {
+      const std::size_t end = std::min(nodes, (b + 1) * kBlock);
+      std::size_t count = 0;
 #pragma omp simd reduction(+ : count)
-    for (std::size_t i = b * kBlock; i < end; ++i) {
-      int present = 0;
-      for (int f = 0; f < F; ++f) present += m[std::size_t(f) * nodes + i] > mass_threshold;
-      count += present >= 2;
+      for (std::size_t i = b * kBlock; i < end; ++i) count += present(i);
+      offset[b + 1] = count;
     }
-    offset[b + 1] = count;
-  }
-  for (std::size_t b = 0; b < blocks; ++b) offset[b + 1] += offset[b];
-  list.resize(offset[blocks]);
-
-#pragma omp parallel for schedule(static) if (nodes >= kParallelMin)
-  for (std::size_t b = 0; b < blocks; ++b) {
-    const std::size_t end = std::min(nodes, (b + 1) * kBlock);
-    std::size_t out = offset[b];
-    for (std::size_t i = b * kBlock; i < end; ++i) {
-      int present = 0;
-      for (int f = 0; f < F; ++f) present += m[std::size_t(f) * nodes + i] > mass_threshold;
-      if (present >= 2) list[out++] = std::uint32_t(i);
+#pragma omp barrier
+#pragma omp single
+    {
+      for (std::size_t b = 0; b < blocks; ++b) offset[b + 1] += offset[b];
+      list.resize(offset[blocks]);
+    }
+    for (std::size_t b = b0; b < b1; ++b) {
+      const std::size_t end = std::min(nodes, (b + 1) * kBlock);
+      std::size_t out = offset[b];
+      for (std::size_t i = b * kBlock; i < end; ++i)
+        if (present(i)) list[out++] = std::uint32_t(i);
     }
   }
 }
@@ -498,10 +506,17 @@ void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::si
   for (int ia = 0; ia < K; ++ia) apply(nf.field[ia], change[ia], force[ia], Real(1));
 }
 
+// The chunks of the list from `first` to `last`, each taken by one thread
+// through a shared cursor.
+struct alignas(64) ChunkCursor {
+  std::atomic<std::size_t> next{0};
+  std::size_t last = 0;
+};
+
 template <int D, class Real, bool kPassA>
 void run_pass(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
               const MMConfig<D, Real>& cfg, MMStats& stats, const unsigned char* flags_in,
-              unsigned char* flags_out) {
+              unsigned char* flags_out, const NodeOwnership& own) {
   assert(validate_multimaterial(grid, cfg) == nullptr);
   const int F = cfg.fields;
   if (stats.rigid_reaction.size() != std::size_t(F))
@@ -516,29 +531,55 @@ void run_pass(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
   std::vector<ChunkStats> partial(chunks);
   std::vector<double> reactions(chunks * reaction_stride, 0.0);
   for (std::size_t c = 0; c < chunks; ++c) partial[c].reaction = &reactions[c * reaction_stride];
+  std::vector<ChunkCursor> cursor;
 
-    // A node costs a few hundred ns: below ~1000 nodes one thread is faster
-    // than waking a team.
+  // A node costs a few hundred ns: below ~1000 nodes one thread is faster
+  // than waking a team.
 #pragma omp parallel if (n >= kParallelNodes)
   {
+    const std::size_t team = std::size_t(omp_get_num_threads());
+    const std::size_t me = std::size_t(omp_get_thread_num());
+    // A chunk belongs to the thread that owns its first node
+    // (kernels/node_ownership.hpp): P2G wrote that node's fields from this
+    // thread's tiles, so they are in its cache. Handed out dynamically, about
+    // half of the chunks' grid lines crossed between the cores. A thread done
+    // with its own chunks takes the others' next ones: the multimaterial
+    // nodes may lie mostly in one thread's part (one straight interface).
+#pragma omp single
+    {
+      cursor = std::vector<ChunkCursor>(team);
+      auto first_chunk = [&](std::size_t i) {
+        if (i == team) return chunks;
+        const std::size_t node = own.range(grid.nodes, team, i).first;
+        const auto k = std::size_t(std::lower_bound(list.begin(), list.end(), node) - list.begin());
+        return (k + kChunk - 1) / kChunk;
+      };
+      for (std::size_t i = 0; i < team; ++i) {
+        cursor[i].next.store(first_chunk(i), std::memory_order_relaxed);
+        cursor[i].last = first_chunk(i + 1);
+      }
+    }
     NodeFields<D, Real> nf;
     // A chunk's statistics are summed in the thread's own copy and stored
     // once per chunk: neighbouring chunks' entries share cache lines, and
-    // updating them node by node from two threads made the pass slower on
-    // 2 threads than on 1 (bench 2d_gimp_inclusions, 22 000 nodes: 0.8x).
+    // updating them node by node from two threads was slower than one thread.
     std::vector<double> reaction(reaction_stride);
-#pragma omp for schedule(dynamic, 1)
-    for (std::size_t c = 0; c < chunks; ++c) {
-      ChunkStats local;
-      std::fill(reaction.begin(), reaction.end(), 0.0);
-      local.reaction = reaction.data();
-      const std::size_t end = std::min(n, (c + 1) * kChunk);
-      for (std::size_t k = c * kChunk; k < end; ++k)
-        process_node<D, Real, kPassA>(grid, cfg, k, list[k], needs, nf, flags_in, flags_out,
-                                      local);
-      local.reaction = partial[c].reaction;
-      std::copy(reaction.begin(), reaction.end(), local.reaction);
-      partial[c] = local;
+    for (std::size_t step = 0; step < team; ++step) {
+      ChunkCursor& from = cursor[(me + step) % team];
+      for (;;) {
+        const std::size_t c = from.next.fetch_add(1, std::memory_order_relaxed);
+        if (c >= from.last) break;
+        ChunkStats local;
+        std::fill(reaction.begin(), reaction.end(), 0.0);
+        local.reaction = reaction.data();
+        const std::size_t end = std::min(n, (c + 1) * kChunk);
+        for (std::size_t k = c * kChunk; k < end; ++k)
+          process_node<D, Real, kPassA>(grid, cfg, k, list[k], needs, nf, flags_in, flags_out,
+                                        local);
+        local.reaction = partial[c].reaction;
+        std::copy(reaction.begin(), reaction.end(), local.reaction);
+        partial[c] = local;
+      }
     }
   }
 
@@ -561,9 +602,9 @@ void run_pass(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
 template <int D, class Real>
 void multimaterial_pass_a(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
                           const MMConfig<D, Real>& cfg, MMStats& stats,
-                          std::vector<unsigned char>& stick_flags) {
+                          std::vector<unsigned char>& stick_flags, const NodeOwnership& own = {}) {
   stick_flags.assign(list.size() * std::size_t(cfg.fields), 0);
-  mm_detail::run_pass<D, Real, true>(grid, list, cfg, stats, nullptr, stick_flags.data());
+  mm_detail::run_pass<D, Real, true>(grid, list, cfg, stats, nullptr, stick_flags.data(), own);
 }
 
 // Pass B (ALGORITHM §2 step 5), after the grid momentum update, with the same list, the
@@ -571,9 +612,10 @@ void multimaterial_pass_a(GridView<D, Real>& grid, const std::vector<std::uint32
 template <int D, class Real>
 void multimaterial_pass_b(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
                           const MMConfig<D, Real>& cfg,
-                          const std::vector<unsigned char>& stick_flags, MMStats& stats) {
+                          const std::vector<unsigned char>& stick_flags, MMStats& stats,
+                          const NodeOwnership& own = {}) {
   assert(stick_flags.size() == list.size() * std::size_t(cfg.fields));
-  mm_detail::run_pass<D, Real, false>(grid, list, cfg, stats, stick_flags.data(), nullptr);
+  mm_detail::run_pass<D, Real, false>(grid, list, cfg, stats, stick_flags.data(), nullptr, own);
 }
 
 }  // namespace mmpm

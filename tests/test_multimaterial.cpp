@@ -133,20 +133,21 @@ PairParams<Real> interface_params(Real Dn, Real Dt) {
 
 template <int D, class Real>
 void run_pass_a(TestGrid<D, Real>& grid, TestSetup<D, Real>& setup, MMStats& stats,
-                std::vector<unsigned char>& flags, Real threshold = Real(1e-12)) {
+                std::vector<unsigned char>& flags, Real threshold = Real(1e-12),
+                const mmpm::NodeOwnership& own = {}) {
   std::vector<std::uint32_t> list;
-  mmpm::find_multimaterial_nodes(grid.view, threshold, list);
+  mmpm::find_multimaterial_nodes(grid.view, threshold, list, own);
   ASSERT_EQ(mmpm::validate_multimaterial(grid.view, setup.config()), nullptr);
   stats.reset(setup.F);
-  mmpm::multimaterial_pass_a(grid.view, list, setup.config(), stats, flags);
+  mmpm::multimaterial_pass_a(grid.view, list, setup.config(), stats, flags, own);
 }
 
 template <int D, class Real>
 void run_pass_b(TestGrid<D, Real>& grid, TestSetup<D, Real>& setup, MMStats& stats,
-                const std::vector<unsigned char>& flags) {
+                const std::vector<unsigned char>& flags, const mmpm::NodeOwnership& own = {}) {
   std::vector<std::uint32_t> list;
-  mmpm::find_multimaterial_nodes(grid.view, Real(1e-12), list);
-  mmpm::multimaterial_pass_b(grid.view, list, setup.config(), flags, stats);
+  mmpm::find_multimaterial_nodes(grid.view, Real(1e-12), list, own);
+  mmpm::multimaterial_pass_b(grid.view, list, setup.config(), flags, stats, own);
 }
 
 // One node, two materials approaching along x (a = field 0 moving +x into b).
@@ -427,8 +428,7 @@ TEST(MultimaterialNormals, StraightInterfaceOnGridLineAndMidplane) {
       ASSERT_GT(pg.omega(0, 4, iy), 0.0);
       ASSERT_GT(pg.omega(1, 4, iy), 0.0);
       const auto mvg = mmpm::normal_mvg<2, double>(ga, gb);
-      const auto avg =
-          mmpm::normal_avg<2, double>(pg.omega(0, 4, iy), ga, pg.omega(1, 4, iy), gb);
+      const auto avg = mmpm::normal_avg<2, double>(pg.omega(0, 4, iy), ga, pg.omega(1, 4, iy), gb);
       EXPECT_NEAR(mvg[0], 1.0, kTol) << "x0 " << x0;
       EXPECT_NEAR(mvg[1], 0.0, kTol);
       EXPECT_NEAR(avg[0], 1.0, kTol);
@@ -531,7 +531,8 @@ TEST(MultimaterialGeometry, HPerpEqualsCellSizeOnRegularMesh) {
   std::mt19937 rng(3);
   std::normal_distribution<double> gauss;
   for (int k = 0; k < 500; ++k) {
-    const auto n3 = mmpm::mm_detail::normalized_or_zero<3, double>({gauss(rng), gauss(rng), gauss(rng)});
+    const auto n3 =
+        mmpm::mm_detail::normalized_or_zero<3, double>({gauss(rng), gauss(rng), gauss(rng)});
     const auto t3 = mmpm::tangent_or_perpendicular<3, double>({0, 0, 0}, 0.0, n3);
     EXPECT_NEAR(mmpm::h_perp_3d<double>(n3, t3, {0.7, 0.7, 0.7}), 0.7, 1e-14);
     const auto n2 = mmpm::mm_detail::normalized_or_zero<2, double>({gauss(rng), gauss(rng)});
@@ -546,7 +547,8 @@ TEST(MultimaterialGeometry, HPerpMatchesNumericEllipsoid) {
   std::normal_distribution<double> gauss;
   const std::array<double, 3> h{0.5, 1.0, 2.0};
   for (int k = 0; k < 300; ++k) {
-    const auto n = mmpm::mm_detail::normalized_or_zero<3, double>({gauss(rng), gauss(rng), gauss(rng)});
+    const auto n =
+        mmpm::mm_detail::normalized_or_zero<3, double>({gauss(rng), gauss(rng), gauss(rng)});
     // A random tangent: project a random vector onto the plane ⟂ n.
     mmpm::VecD<3, double> r{gauss(rng), gauss(rng), gauss(rng)};
     const double rn = r[0] * n[0] + r[1] * n[1] + r[2] * n[2];
@@ -820,8 +822,7 @@ TEST(MultimaterialExact, MidpointStepLandsOnExactOscillator) {
       const double ua1 = 0.0 + dt / ma * (pa + 0.5 * dt * (fa + r.force));
       const double ub1 = s0 + dt / mb * (pb + 0.5 * dt * (fb - r.force));
       const double s_star = fdiff / k;
-      const double exact =
-          s_star + (s0 - s_star) * std::cos(theta) + w0 / omega * std::sin(theta);
+      const double exact = s_star + (s0 - s_star) * std::cos(theta) + w0 / omega * std::sin(theta);
       EXPECT_NEAR(ub1 - ua1, exact, 1e-12) << "theta " << theta << " fdiff " << fdiff;
     }
   }
@@ -853,7 +854,8 @@ TEST(MultimaterialExact, StableWhereExplicitIsNot) {
     }
     return peak;
   };
-  for (const double theta : {0.1, 0.7, 1.2, 1.5}) EXPECT_LE(max_amplitude(theta, true), 1.0 + 1e-12);
+  for (const double theta : {0.1, 0.7, 1.2, 1.5})
+    EXPECT_LE(max_amplitude(theta, true), 1.0 + 1e-12);
   EXPECT_GT(max_amplitude(2.05, false), 1e3);
 }
 
@@ -1088,6 +1090,17 @@ TEST(MultimaterialNodes, FindsAscendingNodesWithTwoOrMoreFields) {
   }
   EXPECT_EQ(list, expected);
   EXPECT_GT(expected.size(), 1000u);
+  // The same list whichever thread owns which blocks (kernels/node_ownership.hpp).
+  const int saved = omp_get_max_threads();
+  omp_set_num_threads(2);
+  for (std::size_t cut : {std::size_t(0), std::size_t(5000), grid.view.nodes}) {
+    mmpm::NodeOwnership own;
+    own.split = {0, cut, grid.view.nodes};
+    std::vector<std::uint32_t> owned;
+    mmpm::find_multimaterial_nodes(grid.view, 1e-9, owned, own);
+    EXPECT_EQ(owned, expected) << "cut at node " << cut;
+  }
+  omp_set_num_threads(saved);
 }
 
 // ------------------------------------------------------------------ determinism
@@ -1108,17 +1121,21 @@ void fill_random(TestGrid<D, Real>& grid, unsigned seed) {
 }
 
 template <int D, class Real>
-void run_both_passes(TestGrid<D, Real>& grid, TestSetup<D, Real>& setup, MMStats& stats) {
+void run_both_passes(TestGrid<D, Real>& grid, TestSetup<D, Real>& setup, MMStats& stats,
+                     const mmpm::NodeOwnership& own = {}) {
   std::vector<unsigned char> flags;
-  run_pass_a(grid, setup, stats, flags);
+  run_pass_a(grid, setup, stats, flags, Real(1e-12), own);
   for (int j = 0; j < grid.view.fields; ++j)
     for (std::size_t i = 0; i < grid.view.nodes; ++i)
       for (int d = 0; d < D; ++d) grid.p[d][grid.at(j, i)] += Real(0.01) * grid.f[d][grid.at(j, i)];
-  run_pass_b(grid, setup, stats, flags);
+  run_pass_b(grid, setup, stats, flags, own);
 }
 
+// 1 thread vs 2 threads with the node split `two_split` (empty: even). A
+// split that gives one thread every node makes the other take all its
+// chunks from the owner's cursor (kernels/multimaterial.hpp run_pass).
 template <int D, class Real>
-void check_thread_independence() {
+void check_thread_independence(std::vector<double> two_split_fraction = {}) {
   auto make_setup = [] {
     TestSetup<D, Real> setup(4, Real(1e-3));
     setup.rigid[3] = 1;
@@ -1126,11 +1143,11 @@ void check_thread_independence() {
     pp.Dn = Real(5e3);
     pp.Dt = Real(2e3);
     pp.friction = Real(0.3);
-    const std::array<Law, 6> laws{Law::stick, Law::frictionless, Law::friction,
-                                  Law::interface, Law::interface, Law::friction};
-    const std::array<NormalMethod, 6> normals{NormalMethod::mvg, NormalMethod::avg,
+    const std::array<Law, 6> laws{Law::stick,     Law::frictionless, Law::friction,
+                                  Law::interface, Law::interface,    Law::friction};
+    const std::array<NormalMethod, 6> normals{NormalMethod::mvg,    NormalMethod::avg,
                                               NormalMethod::radial, NormalMethod::mvg,
-                                              NormalMethod::rigid, NormalMethod::specified};
+                                              NormalMethod::rigid,  NormalMethod::specified};
     int k = 0;
     for (int a = 0; a < 4; ++a)
       for (int b = a + 1; b < 4; ++b, ++k) {
@@ -1143,18 +1160,20 @@ void check_thread_independence() {
     setup.cfg.use_force_difference = true;
     return setup;
   };
-  const std::array<int, 3> dims = D == 2 ? std::array<int, 3>{60, 50, 1}
-                                         : std::array<int, 3>{14, 13, 12};
+  const std::array<int, 3> dims =
+      D == 2 ? std::array<int, 3>{60, 50, 1} : std::array<int, 3>{14, 13, 12};
   TestGrid<D, Real> one(dims, 4), two(dims, 4);
   fill_random(one, 21);
   fill_random(two, 21);
   auto s1 = make_setup(), s2 = make_setup();
   MMStats st1, st2;
+  mmpm::NodeOwnership own;
+  for (double x : two_split_fraction) own.split.push_back(std::size_t(x * double(one.view.nodes)));
   const int saved = omp_get_max_threads();
   omp_set_num_threads(1);
   run_both_passes(one, s1, st1);
   omp_set_num_threads(2);
-  run_both_passes(two, s2, st2);
+  run_both_passes(two, s2, st2, own);
   omp_set_num_threads(saved);
   EXPECT_GT(st1.nodes_2 + st1.nodes_3plus, 500);
   EXPECT_GT(st1.interface_energy, 0.0);
@@ -1176,6 +1195,12 @@ TEST(MultimaterialDeterminism, SameResultsWithOneAndTwoThreads2D) {
 }
 TEST(MultimaterialDeterminism, SameResultsWithOneAndTwoThreads3DFloat) {
   check_thread_independence<3, float>();
+}
+TEST(MultimaterialDeterminism, SameResultsWhicheverThreadOwnsTheNodes) {
+  check_thread_independence<2, double>({0.0, 0.37, 1.0});  // a cut inside a chunk
+  check_thread_independence<2, double>({0.0, 1.0, 1.0});   // thread 1 owns nothing
+  check_thread_independence<2, double>({0.0, 0.0, 1.0});   // thread 0 owns nothing
+  check_thread_independence<3, float>({0.0, 0.9, 1.0});
 }
 
 }  // namespace

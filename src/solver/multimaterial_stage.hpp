@@ -66,29 +66,30 @@ class MultimaterialStage {
   bool has_interface_forces() const { return enabled_ && has_interface_; }
 
   // The step's multimaterial nodes, from the masses of the first P2G.
-  void find_nodes(const GridView<D, Real>& grid) {
+  // `own`: which thread works on which nodes (kernels/node_ownership.hpp).
+  void find_nodes(const GridView<D, Real>& grid, const NodeOwnership& own) {
     if (!enabled_) return;
-    find_multimaterial_nodes(grid, cfg_.mass_threshold, list_);
+    find_multimaterial_nodes(grid, cfg_.mass_threshold, list_, own);
   }
   const std::vector<std::uint32_t>& nodes() const { return list_; }
 
   // After find_nodes and the multimaterial fields' P2G.
-  void pass_a(GridView<D, Real>& grid, double dt) {
+  void pass_a(GridView<D, Real>& grid, double dt, const NodeOwnership& own) {
     if (!enabled_) return;
     cfg_.dt = Real(dt);
     stats_.reset(fields_);
-    multimaterial_pass_a(grid, list_, cfg_, stats_, stick_flags_);
+    multimaterial_pass_a(grid, list_, cfg_, stats_, stick_flags_, own);
   }
   // record_reactions = false for MUSL's repeat of pass B on the
   // re-extrapolated momenta: the step's impulse on rigid bodies is already counted.
-  void pass_b(GridView<D, Real>& grid, bool record_reactions = true) {
+  void pass_b(GridView<D, Real>& grid, const NodeOwnership& own, bool record_reactions = true) {
     if (!enabled_) return;
     if (record_reactions) {
-      multimaterial_pass_b(grid, list_, cfg_, stick_flags_, stats_);
+      multimaterial_pass_b(grid, list_, cfg_, stick_flags_, stats_, own);
       return;
     }
     const auto kept = stats_.rigid_reaction;
-    multimaterial_pass_b(grid, list_, cfg_, stick_flags_, stats_);
+    multimaterial_pass_b(grid, list_, cfg_, stick_flags_, stats_, own);
     stats_.rigid_reaction = kept;
   }
 

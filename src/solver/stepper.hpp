@@ -16,6 +16,7 @@
 #include "kernels/constitutive.hpp"
 #include "kernels/g2p.hpp"
 #include "kernels/grid_update.hpp"
+#include "kernels/node_ownership.hpp"
 #include "kernels/p2g.hpp"
 #include "kernels/p2g_multimaterial.hpp"
 #include "kernels/reduce.hpp"
@@ -109,6 +110,7 @@ class Stepper final : public Simulation {
   void gradient_and_stress();
   void build_stress_table();
   void grid_update_stage();
+  void update_node_ownership(bool rebuilt);
   void finish_velocities(bool with_dvel);
   void apply_boundaries(bool with_dvel);
   void update_tractions();
@@ -143,7 +145,9 @@ class Stepper final : public Simulation {
   std::vector<std::uint32_t> perm_, offsets_, scratch_keys_;
 
   TileLayout<D> tiles_;
-  TileSchedule schedule_;   // tile ranges and each thread's tiles per color
+  TileSchedule schedule_;  // tile ranges and each thread's tiles per color
+  NodeOwnership own_;      // each thread's nodes in the node loops
+  std::size_t own_threads_ = 0;
   ReachTiles reach_tiles_;  // tiles reaching a multimaterial node (p2g_multimaterial)
   // This step's first P2G also scatters mx, vol, g (chosen from the share of
   // particles the previous step's multimaterial nodes reached).

@@ -183,18 +183,12 @@ void Stepper<D, Shape, Real>::sort_particles() {
   for (std::size_t p = 0; p < n; ++p) P_.key[p] = key_of_position(p);
   counting_sort(P_.key, n, tiles_.key_count(), offsets_, perm_);
   scratch_.resize(n);
-  for (auto& col : pcols_.reals) {
-    gather_permute(col.data(), scratch_.data(), perm_.data(), n);
-    std::memcpy(col.data(), scratch_.data(), n * sizeof(Real));
-  }
+  for (auto& col : pcols_.reals) permute_in_place(col.data(), scratch_.data(), perm_.data(), n);
   scratch_bytes_.resize(n);
-  for (auto& col : pcols_.bytes) {
-    gather_permute(col.data(), scratch_bytes_.data(), perm_.data(), n);
-    std::memcpy(col.data(), scratch_bytes_.data(), n);
-  }
+  for (auto& col : pcols_.bytes)
+    permute_in_place(col.data(), scratch_bytes_.data(), perm_.data(), n);
   scratch_keys_.resize(n);
-  gather_permute(P_.key, scratch_keys_.data(), perm_.data(), n);
-  std::memcpy(P_.key, scratch_keys_.data(), n * sizeof(std::uint32_t));
+  permute_in_place(P_.key, scratch_keys_.data(), perm_.data(), n);
   rebuild_ranges();
   dirty_ = false;
 }
@@ -204,6 +198,7 @@ template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::rebuild_ranges() {
   const std::size_t n = P_.n;
   schedule_.build(tiles_, P_.key, n);
+  update_node_ownership(true);
   if (!material_particles_.empty()) {
     for (auto& l : material_particles_) l.clear();
     for (std::size_t p = 0; p < n; ++p) material_particles_[P_.mat[p]].push_back(std::uint32_t(p));
@@ -218,23 +213,39 @@ std::pair<std::size_t, std::size_t> Stepper<D, Shape, Real>::color_share(std::si
                          std::size_t(omp_get_thread_num()));
 }
 
+// The node split for the current team size (kernels/node_ownership.hpp),
+// from the sorted keys; `rebuilt`: the keys changed.
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::update_node_ownership(bool rebuilt) {
+  const auto threads = std::size_t(omp_get_max_threads());
+  if (!rebuilt && own_threads_ == threads) return;
+  own_threads_ = threads;
+  own_ = node_ownership<D>(tiles_, G_.nodes_per_dim, P_.key, P_.n, threads);
+}
+
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::zero_grid(bool mm) {
-  const std::size_t n = G_.nodes * std::size_t(G_.fields);
-  auto zero = [n](Real* a) {
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-    for (std::size_t i = 0; i < n; ++i) a[i] = Real(0);
-  };
-  zero(G_.m);
-  for (int d = 0; d < D; ++d) zero(G_.p[d]), zero(G_.f[d]);
-  if (!mm) return;
-  for (int d = 0; d < D; ++d) zero(G_.fi[d]);
-  if (!mm_fields_with_p2g_) return;  // else p2g_multimaterial zeroes what it writes
-  zero(G_.vol);
-  for (int d = 0; d < D; ++d) {
-    zero(G_.mx[d]);
-    if (G_.g[d]) zero(G_.g[d]);
+  // One region for every array, each thread zeroing the nodes it owns.
+  constexpr std::size_t N = 1 + 2 * D;
+  std::array<Real*, N> base{G_.m};
+  for (int d = 0; d < D; ++d)
+    base[std::size_t(1 + d)] = G_.p[d], base[std::size_t(1 + D + d)] = G_.f[d];
+  // The multimaterial arrays: fi always; mx, vol, g only when this step's
+  // first P2G scatters them, else p2g_multimaterial zeroes what it writes.
+  constexpr std::size_t M = 1 + 3 * D;
+  std::array<Real*, M> extra{};
+  if (mm) {
+    for (int d = 0; d < D; ++d) extra[std::size_t(d)] = G_.fi[d];
+    if (mm_fields_with_p2g_) {
+      extra[D] = G_.vol;
+      for (int d = 0; d < D; ++d)
+        extra[std::size_t(D + 1 + d)] = G_.mx[d], extra[std::size_t(2 * D + 1 + d)] = G_.g[d];
+    }
   }
+  std::array<Real*, N + M> all{};
+  std::copy(base.begin(), base.end(), all.begin());
+  std::copy(extra.begin(), extra.end(), all.begin() + N);
+  zero_owned(own_, G_.nodes, G_.fields, all);
 }
 
 template <int D, class Shape, class Real>
@@ -446,7 +457,7 @@ void Stepper<D, Shape, Real>::grid_update_stage() {
   q.rigid = plan_.rigid.data();
   q.rigid_velocity = reinterpret_cast<const double(*)[3]>(rigid_velocity_now_.data());
   q.has_interface_force = mm_.has_interface_forces();
-  damping_loss_ += grid_update(G_, GV_, q);
+  damping_loss_ += grid_update(G_, GV_, q, own_);
 }
 
 // Supports: the fixed components get the support's velocity; the momentum
@@ -493,14 +504,15 @@ void Stepper<D, Shape, Real>::apply_boundaries(bool with_dvel) {
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::finish_velocities(bool with_dvel) {
   if (with_dvel) {
-    grid_velocities(G_, GV_, mass_threshold_);
+    grid_velocities(G_, GV_, mass_threshold_, own_);
   } else {
-    const std::size_t total = G_.nodes * std::size_t(G_.fields);
-#pragma omp parallel for schedule(static) if (total >= kParallelMin)
-    for (std::size_t i = 0; i < total; ++i) {
-      const Real m = G_.m[i];
-      for (int d = 0; d < D; ++d) GV_.vel[d][i] = m > mass_threshold_ ? G_.p[d][i] / m : Real(0);
-    }
+#pragma omp parallel if (G_.nodes * std::size_t(G_.fields) >= kParallelMin)
+    for_own_nodes(own_, G_.nodes, G_.fields, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) {
+        const Real m = G_.m[i];
+        for (int d = 0; d < D; ++d) GV_.vel[d][i] = m > mass_threshold_ ? G_.p[d][i] / m : Real(0);
+      }
+    });
   }
   apply_boundaries(with_dvel);
 }
@@ -550,6 +562,7 @@ void Stepper<D, Shape, Real>::step() {
   tic();
   const int every = scene_.simulation.sort_every;
   if (dirty_ || (every > 0 && step_ % every == 0)) sort_particles();
+  update_node_ownership(false);
   update_tractions();
   toc(kStageSort);
 
@@ -572,13 +585,13 @@ void Stepper<D, Shape, Real>::step() {
 
   if (mm) {
     tic();
-    mm_.find_nodes(G_);
+    mm_.find_nodes(G_, own_);
     toc(kStageMultimaterial);
     tic();
     p2g_multimaterial();
     toc(kStageP2G);
     tic();
-    mm_.pass_a(G_, dt_);
+    mm_.pass_a(G_, dt_, own_);
     toc(kStageMultimaterial);
   }
 
@@ -598,7 +611,7 @@ void Stepper<D, Shape, Real>::step() {
   toc(kStageGrid);
   if (mm) {
     tic();
-    mm_.pass_b(G_);
+    mm_.pass_b(G_, own_);
     toc(kStageMultimaterial);
   }
   tic();
@@ -621,13 +634,14 @@ void Stepper<D, Shape, Real>::step() {
       x_next_[d].resize(P_.n);
       P_.x_next[d] = x_next_[d].data();
     }
-    const std::size_t n = G_.nodes * std::size_t(G_.fields);
-    for (int d = 0; d < D; ++d) std::fill(G_.p[d], G_.p[d] + n, Real(0));
+    std::array<Real*, D> momenta;
+    for (int d = 0; d < D; ++d) momenta[std::size_t(d)] = G_.p[d];
+    zero_owned(own_, G_.nodes, G_.fields, momenta);
     g2p_colored<kUpdateMotion | kScatterMomentum>();
     toc(kStageG2P);
     if (mm) {
       tic();
-      mm_.pass_b(G_, false);
+      mm_.pass_b(G_, own_, false);
       toc(kStageMultimaterial);
     }
     tic();

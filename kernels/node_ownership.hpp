@@ -1,0 +1,140 @@
+// Which grid nodes each thread works on in the node loops (zeroing, the
+// momentum update, velocities, the multimaterial passes).
+//
+// Why: the two cores of this machine do not share a cache level that is
+// quick to reach; a cache line one core wrote costs the other ~200 ns to
+// read (tools: a ping-pong of one line, 400 ns round trip). The colored
+// P2G writes the nodes around each thread's tiles, and the G2P reads them
+// back from the same tiles (kernels/binning.hpp TileSchedule), so a node
+// loop that splits the nodes any other way hands about half of every grid
+// array from one core to the other, twice per stage. With two fields the
+// old split of the flat (field, node) range gave thread 0 all of field 0
+// and thread 1 all of field 1: every line P2G wrote then crossed.
+//
+// The ownership is a cut of the node index range at the lowest node of the
+// tile where each thread's particles begin (particles are stored tile by
+// tile, tiles x fastest, like the nodes), so thread i owns, in every field,
+// the nodes of the rows its tiles cover. Which thread runs a node never
+// changes what the node computes, and the reductions below keep their
+// fixed chunks, so results do not depend on the split or the thread count.
+#pragma once
+
+#include <omp.h>
+
+#include <algorithm>
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "kernels/binning.hpp"
+#include "kernels/reduce.hpp"
+
+namespace mmpm {
+
+struct NodeOwnership {
+  // threads + 1 ascending node indices, split[0] = 0, split[threads] = nodes;
+  // empty: an even split.
+  std::vector<std::size_t> split;
+
+  std::size_t threads() const { return split.empty() ? 0 : split.size() - 1; }
+
+  // Nodes [first, last) of thread i of `threads`. A team of another size
+  // than the split was made for (a loop below its parallel threshold runs
+  // on one thread) gets an even split.
+  std::pair<std::size_t, std::size_t> range(std::size_t nodes, std::size_t team,
+                                            std::size_t i) const {
+    if (split.size() != team + 1 || split.back() != nodes) return thread_block(nodes, team, i);
+    return {split[i], split[i + 1]};
+  }
+  // The chunks of `chunk` nodes whose first node thread i owns (for the
+  // reductions, whose chunks are fixed).
+  std::pair<std::size_t, std::size_t> chunks(std::size_t nodes, std::size_t chunk, std::size_t team,
+                                             std::size_t i) const {
+    const auto [b, e] = range(nodes, team, i);
+    return {(b + chunk - 1) / chunk, (e + chunk - 1) / chunk};
+  }
+  // The calling thread's nodes inside a parallel region.
+  std::pair<std::size_t, std::size_t> mine(std::size_t nodes) const {
+    return range(nodes, std::size_t(omp_get_num_threads()), std::size_t(omp_get_thread_num()));
+  }
+};
+
+// The split for `threads` threads from the particles' sorted keys: thread
+// i's particles start at n i / threads (the static particle loops' block,
+// and within a tile the colored passes' quantile), and the cut is the
+// lowest node of that particle's tile.
+template <int D>
+NodeOwnership node_ownership(const TileLayout<D>& layout, const std::array<int, 3>& nodes_per_dim,
+                             const std::uint32_t* sorted_key, std::size_t n, std::size_t threads) {
+  NodeOwnership own;
+  std::size_t nodes = 1;
+  for (int d = 0; d < D; ++d) nodes *= std::size_t(nodes_per_dim[std::size_t(d)]);
+  if (threads < 2 || n == 0) return own;
+  own.split.assign(threads + 1, 0);
+  for (std::size_t i = 1; i < threads; ++i) {
+    std::uint32_t tile = layout.tile_of_key(sorted_key[n * i / threads]);
+    std::size_t node = 0, stride = 1;
+    for (int d = 0; d < D; ++d) {
+      const std::size_t t = tile % std::uint32_t(layout.tiles[std::size_t(d)]);
+      tile /= std::uint32_t(layout.tiles[std::size_t(d)]);
+      node += (t << layout.shift) * stride;
+      stride *= std::size_t(nodes_per_dim[std::size_t(d)]);
+    }
+    own.split[i] = std::clamp(node, own.split[i - 1], nodes);
+  }
+  own.split[threads] = nodes;
+  return own;
+}
+
+// body(first, last) over the calling thread's own nodes of every field, as
+// flat (field, node) indices; call inside a parallel region.
+template <class Body>
+inline void for_own_nodes(const NodeOwnership& own, std::size_t nodes, int fields, Body&& body) {
+  const auto [b, e] = own.mine(nodes);
+  if (b >= e) return;
+  for (int f = 0; f < fields; ++f) body(std::size_t(f) * nodes + b, std::size_t(f) * nodes + e);
+}
+
+// Arrays of fields x nodes set to zero, each thread its own nodes, in one
+// parallel region.
+template <class Real, std::size_t N>
+void zero_owned(const NodeOwnership& own, std::size_t nodes, int fields,
+                const std::array<Real*, N>& arrays) {
+#pragma omp parallel if (nodes * std::size_t(fields) >= kParallelMin)
+  for_own_nodes(own, nodes, fields, [&](std::size_t b, std::size_t e) {
+    for (Real* a : arrays)
+      if (a) std::fill(a + b, a + e, Real(0));
+  });
+}
+
+// Per field f, the sum over its nodes of body(f, first, last, acc) (K
+// values), computed in the fixed chunks of deterministic_sum and added in
+// chunk order, so the totals are bitwise those of deterministic_sum field by
+// field; each thread sums the chunks that start on its own nodes.
+template <int K, class Body>
+std::vector<std::array<double, K>> owned_field_sums(const NodeOwnership& own, std::size_t nodes,
+                                                    int fields, Body&& body) {
+  const std::size_t chunks = chunk_count(nodes);
+  std::vector<std::array<double, K>> partial(chunks * std::size_t(fields));
+#pragma omp parallel if (nodes * std::size_t(fields) >= kParallelMin)
+  {
+    const auto [c0, c1] = own.chunks(nodes, kReduceChunk, std::size_t(omp_get_num_threads()),
+                                     std::size_t(omp_get_thread_num()));
+    for (int f = 0; f < fields; ++f)
+      for (std::size_t c = c0; c < c1; ++c) {
+        std::array<double, K> acc{};
+        body(f, c * kReduceChunk, std::min(nodes, (c + 1) * kReduceChunk), acc);
+        partial[std::size_t(f) * chunks + c] = acc;
+      }
+  }
+  std::vector<std::array<double, K>> total(std::size_t(fields), std::array<double, K>{});
+  for (int f = 0; f < fields; ++f)
+    for (std::size_t c = 0; c < chunks; ++c)
+      for (int k = 0; k < K; ++k)
+        total[std::size_t(f)][k] += partial[std::size_t(f) * chunks + c][k];
+  return total;
+}
+
+}  // namespace mmpm

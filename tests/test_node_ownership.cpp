@@ -1,0 +1,165 @@
+// Which thread works on which grid nodes (kernels/node_ownership.hpp): the
+// split follows the particles' tiles, and the node loops that use it give
+// the same results whatever the split and the thread count.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <algorithm>
+#include <cstring>
+#include <random>
+#include <vector>
+
+#include "kernels/binning.hpp"
+#include "kernels/grid_update.hpp"
+#include "kernels/node_ownership.hpp"
+
+namespace {
+
+using mmpm::NodeOwnership;
+
+// Sorted keys of one particle per cell in cells [lo, hi) of each direction.
+template <int D>
+std::vector<std::uint32_t> block_keys(const mmpm::TileLayout<D>& layout, std::array<int, 3> lo,
+                                      std::array<int, 3> hi) {
+  std::vector<std::uint32_t> keys;
+  for (int k = D == 3 ? lo[2] : 0; k < (D == 3 ? hi[2] : 1); ++k)
+    for (int j = lo[1]; j < hi[1]; ++j)
+      for (int i = lo[0]; i < hi[0]; ++i) keys.push_back(layout.key({i, j, k}));
+  std::sort(keys.begin(), keys.end());
+  return keys;
+}
+
+TEST(NodeOwnership, CutsAtTheTileWhereEachThreadsParticlesBegin2D) {
+  // 64 x 64 cells (65 x 65 nodes), tiles of 8: an 8 x 8 tile grid. One
+  // particle per cell in every cell: particle n/2 is the first of tile row
+  // 4, so thread 1 owns the nodes from row 32 up.
+  mmpm::TileLayout<2> layout;
+  layout.setup(8, {64, 64, 1});
+  const std::array<int, 3> nodes{65, 65, 1};
+  const auto keys = block_keys<2>(layout, {0, 0, 0}, {64, 64, 1});
+  const NodeOwnership two = mmpm::node_ownership<2>(layout, nodes, keys.data(), keys.size(), 2);
+  EXPECT_EQ(two.split, (std::vector<std::size_t>{0, 32 * 65, 65 * 65}));
+  // Four threads: tile rows 2, 4, 6.
+  const NodeOwnership four = mmpm::node_ownership<2>(layout, nodes, keys.data(), keys.size(), 4);
+  EXPECT_EQ(four.split, (std::vector<std::size_t>{0, 16 * 65, 32 * 65, 48 * 65, 65 * 65}));
+  // Particles only in the upper-right quarter (cells 32..63): particle n/2
+  // is in tile row 6 (cells 48..55), first tile x = 4 (cell 32).
+  const auto quarter = block_keys<2>(layout, {32, 32, 0}, {64, 64, 1});
+  const NodeOwnership q = mmpm::node_ownership<2>(layout, nodes, quarter.data(), quarter.size(), 2);
+  EXPECT_EQ(q.split, (std::vector<std::size_t>{0, 48 * 65 + 32, 65 * 65}));
+}
+
+TEST(NodeOwnership, CutsAtTheTileWhereEachThreadsParticlesBegin3D) {
+  // 16^3 cells, tiles of 4: particle n/2 is the first of tile layer z = 2
+  // (cell 8), so thread 1 owns nodes from z layer 8 up.
+  mmpm::TileLayout<3> layout;
+  layout.setup(4, {16, 16, 16});
+  const std::array<int, 3> nodes{17, 17, 17};
+  const auto keys = block_keys<3>(layout, {0, 0, 0}, {16, 16, 16});
+  const NodeOwnership two = mmpm::node_ownership<3>(layout, nodes, keys.data(), keys.size(), 2);
+  EXPECT_EQ(two.split, (std::vector<std::size_t>{0, 8 * 17 * 17, 17 * 17 * 17}));
+}
+
+TEST(NodeOwnership, OtherTeamSizesAndNoParticlesGetAnEvenSplit) {
+  NodeOwnership own;
+  own.split = {0, 10, 100};
+  EXPECT_EQ(own.range(100, 2, 0), (std::pair<std::size_t, std::size_t>{0, 10}));
+  EXPECT_EQ(own.range(100, 2, 1), (std::pair<std::size_t, std::size_t>{10, 100}));
+  // A one-thread team (a loop below its parallel threshold) does every node.
+  EXPECT_EQ(own.range(100, 1, 0), (std::pair<std::size_t, std::size_t>{0, 100}));
+  EXPECT_EQ(own.range(100, 3, 1), (std::pair<std::size_t, std::size_t>{33, 66}));
+  // A split made for another grid size is not used.
+  EXPECT_EQ(own.range(50, 2, 1), (std::pair<std::size_t, std::size_t>{25, 50}));
+  // Reduction chunks go to the thread owning their first node.
+  EXPECT_EQ(own.chunks(100, 16, 2, 0), (std::pair<std::size_t, std::size_t>{0, 1}));
+  EXPECT_EQ(own.chunks(100, 16, 2, 1), (std::pair<std::size_t, std::size_t>{1, 7}));
+  mmpm::TileLayout<2> layout;
+  layout.setup(8, {16, 16, 1});
+  EXPECT_TRUE(mmpm::node_ownership<2>(layout, {17, 17, 1}, nullptr, 0, 2).split.empty());
+}
+
+// A grid of 2 fields with random masses (some slivers, some empty), momenta
+// and forces, as the momentum update finds it after P2G.
+struct UpdateGrid {
+  static constexpr int D = 2;
+  std::size_t nodes;
+  std::vector<double> m, p0, p1, f0, f1, fi0, fi1, v0, v1, dv0, dv1;
+  mmpm::GridView<2, double> G;
+  mmpm::GridVelocity<2, double> V;
+  explicit UpdateGrid(std::array<int, 3> dims)
+      : nodes(std::size_t(dims[0]) * std::size_t(dims[1])) {
+    const std::size_t total = 2 * nodes;
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-1, 1);
+    for (auto* a : {&m, &p0, &p1, &f0, &f1, &fi0, &fi1, &v0, &v1, &dv0, &dv1}) a->assign(total, 0);
+    for (std::size_t i = 0; i < total; ++i) {
+      const double r = u(rng);
+      m[i] = r < -0.5 ? 0.0 : (r < -0.4 ? 1e-14 : 1 + r);
+      p0[i] = u(rng), p1[i] = u(rng), f0[i] = u(rng), f1[i] = u(rng);
+      fi0[i] = u(rng), fi1[i] = u(rng);
+    }
+    G.nodes_per_dim = dims;
+    G.nodes = nodes;
+    G.fields = 2;
+    G.m = m.data();
+    G.p = {p0.data(), p1.data()};
+    G.f = {f0.data(), f1.data()};
+    G.fi = {fi0.data(), fi1.data()};
+    V.vel = {v0.data(), v1.data()};
+    V.dvel = {dv0.data(), dv1.data()};
+  }
+};
+
+TEST(NodeOwnership, GridUpdateAndVelocitiesBitwiseWhateverTheSplit) {
+  // 300 x 170 nodes (13 reduction chunks per field), damping on so the
+  // loss is a real sum; 1 thread vs 2 threads with several cuts.
+  const std::array<int, 3> dims{300, 170, 1};
+  mmpm::GridUpdateParams q;
+  q.dt = 1e-3;
+  q.damping = 0.7;
+  q.mass_threshold = 1e-12;
+  q.body_accel[1] = -9.81;
+  q.has_interface_force = true;
+  auto run = [&](int threads, std::vector<std::size_t> split, UpdateGrid& g) {
+    const int saved = omp_get_max_threads();
+    omp_set_num_threads(threads);
+    NodeOwnership own;
+    own.split = std::move(split);
+    const double loss = mmpm::grid_update(g.G, g.V, q, own);
+    mmpm::grid_velocities(g.G, g.V, 1e-12, own);
+    omp_set_num_threads(saved);
+    return loss;
+  };
+  UpdateGrid ref(dims);
+  const double loss_ref = run(1, {}, ref);
+  EXPECT_GT(loss_ref, 0.0);
+  const std::size_t n = ref.nodes;
+  for (const auto& split : std::vector<std::vector<std::size_t>>{
+           {}, {0, 1, n}, {0, 4096 * 5 + 17, n}, {0, n, n}, {0, 0, n}}) {
+    UpdateGrid g(dims);
+    const double loss = run(2, split, g);
+    EXPECT_EQ(loss, loss_ref) << "split at " << (split.empty() ? 0 : split[1]);
+    for (auto [a, b] : {std::pair{&ref.p0, &g.p0},
+                        {&ref.p1, &g.p1},
+                        {&ref.v0, &g.v0},
+                        {&ref.v1, &g.v1},
+                        {&ref.dv0, &g.dv0},
+                        {&ref.dv1, &g.dv1}})
+      EXPECT_EQ(std::memcmp(a->data(), b->data(), a->size() * sizeof(double)), 0);
+  }
+}
+
+TEST(NodeOwnership, ZeroOwnedClearsEveryFieldOfEveryNode) {
+  const std::size_t nodes = 20000;
+  std::vector<double> a(3 * nodes, 1.0), b(3 * nodes, 2.0);
+  const int saved = omp_get_max_threads();
+  omp_set_num_threads(2);
+  NodeOwnership own;
+  own.split = {0, 12345, nodes};
+  mmpm::zero_owned(own, nodes, 3, std::array<double*, 3>{a.data(), nullptr, b.data()});
+  omp_set_num_threads(saved);
+  EXPECT_TRUE(std::all_of(a.begin(), a.end(), [](double x) { return x == 0.0; }));
+  EXPECT_TRUE(std::all_of(b.begin(), b.end(), [](double x) { return x == 0.0; }));
+}
+
+}  // namespace
