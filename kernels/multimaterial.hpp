@@ -63,6 +63,18 @@ struct PairGeometry {
   bool valid = false;
 };
 
+// What pass B needs of pass A's geometry for one interaction (node, field a).
+// m, mx, Ω and g do not change between the passes (only the momenta do), so
+// neither do the normal and the corrected normal separation; recomputing
+// them (two square roots and four divisions on a dependent chain) was about
+// half of a pass B, which MUSL runs twice per step (docs/multimaterial.md,
+// "Pass B reuses pass A's geometry").
+template <int D, class Real>
+struct SavedGeometry {
+  VecD<D, Real> n{};  // unit normal a → b; zero: pass A found no usable geometry
+  Real dn = 0;        // corrected normal separation (§4.3)
+};
+
 // Checks a configuration once, outside the hot loops. nullptr when usable.
 template <int D, class Real>
 const char* validate_multimaterial(const GridView<D, Real>& grid, const MMConfig<D, Real>& cfg) {
@@ -257,12 +269,17 @@ InteractionResult<D, Real> interact_pass_a(const MaterialSide<D, Real>& a,
                                            const PairParams<Real>& pp, Real sign,
                                            const std::array<Real, 3>& node_position,
                                            const std::array<Real, 3>& h, Real dt, Real thickness,
-                                           bool use_force_difference) {
+                                           bool use_force_difference,
+                                           SavedGeometry<D, Real>* save) {
   InteractionResult<D, Real> r;
   const PairGeometry<D, Real> G =
       screened_geometry<D, Real>(a, b, b_is_rigid, pp, sign, node_position, h);
-  if (!G.valid) return r;
+  if (!G.valid) {
+    if (save) *save = SavedGeometry<D, Real>{};
+    return r;
+  }
   const Real dn = corrected_normal_separation(pp.separation, G.delta_n, G.h_perp);
+  if (save) *save = SavedGeometry<D, Real>{G.n, dn};
   if (pp.law != Law::interface) return contact_result<D, Real>(G, pp, dn);
 
   r.evaluated = true;
@@ -309,6 +326,27 @@ InteractionResult<D, Real> interact_pass_b(const MaterialSide<D, Real>& a,
   return r;
 }
 
+// Pass B from pass A's saved geometry: the same outcome as interact_pass_b
+// (which recomputes the normal and separation from the same m, mx, Ω, g),
+// with only Δp computed from the updated momenta.
+template <int D, class Real>
+InteractionResult<D, Real> interact_pass_b_saved(const MaterialSide<D, Real>& a,
+                                                 const MaterialSide<D, Real>& b, bool b_is_rigid,
+                                                 const PairParams<Real>& pp,
+                                                 const SavedGeometry<D, Real>& saved,
+                                                 unsigned char stick_flags) {
+  InteractionResult<D, Real> r;
+  if (pp.law == Law::interface && stick_flags == 0) return r;
+  if (dot<D, Real>(saved.n, saved.n) == Real(0)) return r;
+  PairGeometry<D, Real> G;
+  G.n = saved.n;
+  G.dp = momentum_change_to_center_of_mass<D, Real>(a.m, a.p, b.m, b.p, b_is_rigid);
+  if (pp.law != Law::interface) return contact_result<D, Real>(G, pp, saved.dn);
+  r.evaluated = true;
+  r.momentum_change = directional_stick_change<D, Real>(stick_flags, G.dp, G.n);
+  return r;
+}
+
 // The fields present at a node, gathered into contiguous local arrays.
 template <int D, class Real>
 struct NodeFields {
@@ -319,6 +357,7 @@ struct NodeFields {
 
 // What the pairs of a configuration read besides m, p, mx, vol.
 struct PassNeeds {
+  bool geometry = true;   // mx (pass B from saved geometry reads only m, Ω, p)
   bool gradient = false;  // some pair uses the mvg / avg / rigid normal
   bool position = false;  // some pair uses the radial normal
   bool force = false;     // Δf_i (pass A with cfg.use_force_difference)
@@ -353,7 +392,7 @@ void gather_node(const GridView<D, Real>& grid, std::size_t node, Real mass_thre
     s.vol = grid.vol[at];
     for (int d = 0; d < D; ++d) {
       s.p[d] = grid.p[d][at];
-      s.mx[d] = grid.mx[d][at];
+      s.mx[d] = needs.geometry ? grid.mx[d][at] : Real(0);
       s.g[d] = needs.gradient ? grid.g[d][at] : Real(0);
       s.f[d] = needs.force ? grid.f[d][at] : Real(0);
     }
@@ -401,7 +440,9 @@ inline VecD<D, Real> reaction_change(const InteractionResult<D, Real>& r) {
 template <int D, class Real, bool kPassA>
 void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::size_t k,
                   std::size_t node, const PassNeeds& needs, NodeFields<D, Real>& nf,
-                  const unsigned char* flags_in, unsigned char* flags_out, ChunkStats& cs) {
+                  const unsigned char* flags_in, unsigned char* flags_out,
+                  const SavedGeometry<D, Real>* geometry_in, SavedGeometry<D, Real>* geometry_out,
+                  ChunkStats& cs) {
   const int F = cfg.fields;
   gather_node<D, Real>(grid, node, cfg.mass_threshold, needs, nf);
   const int K = nf.count;
@@ -420,12 +461,15 @@ void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::si
   auto interact = [&](const MaterialSide<D, Real>& a, const MaterialSide<D, Real>& b, bool b_rigid,
                       const PairParams<Real>& pp, int field_a) {
     const Real sign = field_a == pp.first_field ? Real(1) : Real(-1);
+    const std::size_t slot = k * std::size_t(F) + std::size_t(field_a);
     if constexpr (kPassA) {
       return interact_pass_a<D, Real>(a, b, b_rigid, pp, sign, x_node, grid.h, cfg.dt,
-                                      cfg.thickness, cfg.use_force_difference);
+                                      cfg.thickness, cfg.use_force_difference,
+                                      geometry_out ? &geometry_out[slot] : nullptr);
     } else {
-      return interact_pass_b<D, Real>(a, b, b_rigid, pp, sign, x_node, grid.h,
-                                      flags_in[k * std::size_t(F) + std::size_t(field_a)]);
+      if (geometry_in)
+        return interact_pass_b_saved<D, Real>(a, b, b_rigid, pp, geometry_in[slot], flags_in[slot]);
+      return interact_pass_b<D, Real>(a, b, b_rigid, pp, sign, x_node, grid.h, flags_in[slot]);
     }
   };
   auto apply = [&](int field, const VecD<D, Real>& dp, const VecD<D, Real>& force, Real s) {
@@ -516,14 +560,16 @@ struct alignas(64) ChunkCursor {
 template <int D, class Real, bool kPassA>
 void run_pass(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
               const MMConfig<D, Real>& cfg, MMStats& stats, const unsigned char* flags_in,
-              unsigned char* flags_out, const NodeOwnership& own) {
+              unsigned char* flags_out, const SavedGeometry<D, Real>* geometry_in,
+              SavedGeometry<D, Real>* geometry_out, const NodeOwnership& own) {
   assert(validate_multimaterial(grid, cfg) == nullptr);
   const int F = cfg.fields;
   if (stats.rigid_reaction.size() != std::size_t(F))
     stats.rigid_reaction.resize(std::size_t(F), std::array<double, 3>{0, 0, 0});
   const std::size_t n = list.size();
   if (n == 0) return;
-  const PassNeeds needs = pass_needs(cfg, kPassA);
+  PassNeeds needs = pass_needs(cfg, kPassA);
+  if (geometry_in) needs.geometry = needs.gradient = needs.position = false;
 
   constexpr std::size_t kChunk = 64;  // fixed: the reduction order never depends on threads
   const std::size_t chunks = (n + kChunk - 1) / kChunk;
@@ -575,7 +621,7 @@ void run_pass(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
         const std::size_t end = std::min(n, (c + 1) * kChunk);
         for (std::size_t k = c * kChunk; k < end; ++k)
           process_node<D, Real, kPassA>(grid, cfg, k, list[k], needs, nf, flags_in, flags_out,
-                                        local);
+                                        geometry_in, geometry_out, local);
         local.reaction = partial[c].reaction;
         std::copy(reaction.begin(), reaction.end(), local.reaction);
         partial[c] = local;
@@ -598,24 +644,34 @@ void run_pass(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
 // Pass A (ALGORITHM §2 step 3), after P2G filled m, p, mx, vol, g (and f if
 // cfg.use_force_difference). The caller zeroes grid.fi beforehand. stick_flags is resized
 // to list.size() * F and written: entry [k*F + a] holds the kStick* bits of the
-// interaction computed for field a at node list[k].
+// interaction computed for field a at node list[k]. `geometry`, when given, is resized
+// the same way and receives each interaction's normal and corrected separation for
+// pass B. `own`: which thread starts on which nodes (kernels/node_ownership.hpp).
 template <int D, class Real>
 void multimaterial_pass_a(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
                           const MMConfig<D, Real>& cfg, MMStats& stats,
-                          std::vector<unsigned char>& stick_flags, const NodeOwnership& own = {}) {
+                          std::vector<unsigned char>& stick_flags, const NodeOwnership& own = {},
+                          std::vector<SavedGeometry<D, Real>>* geometry = nullptr) {
   stick_flags.assign(list.size() * std::size_t(cfg.fields), 0);
-  mm_detail::run_pass<D, Real, true>(grid, list, cfg, stats, nullptr, stick_flags.data(), own);
+  if (geometry) geometry->resize(list.size() * std::size_t(cfg.fields));
+  mm_detail::run_pass<D, Real, true>(grid, list, cfg, stats, nullptr, stick_flags.data(), nullptr,
+                                     geometry ? geometry->data() : nullptr, own);
 }
 
 // Pass B (ALGORITHM §2 step 5), after the grid momentum update, with the same list, the
 // same m, mx, vol, g and the stick_flags of pass A. No interface force, no energy.
+// With pass A's `geometry` it reads only m, vol and p at the nodes and takes the normal
+// and separation from pass A; without, it recomputes them (the same values).
 template <int D, class Real>
 void multimaterial_pass_b(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
                           const MMConfig<D, Real>& cfg,
                           const std::vector<unsigned char>& stick_flags, MMStats& stats,
-                          const NodeOwnership& own = {}) {
+                          const NodeOwnership& own = {},
+                          const std::vector<SavedGeometry<D, Real>>* geometry = nullptr) {
   assert(stick_flags.size() == list.size() * std::size_t(cfg.fields));
-  mm_detail::run_pass<D, Real, false>(grid, list, cfg, stats, stick_flags.data(), nullptr, own);
+  assert(!geometry || geometry->size() == stick_flags.size());
+  mm_detail::run_pass<D, Real, false>(grid, list, cfg, stats, stick_flags.data(), nullptr,
+                                      geometry ? geometry->data() : nullptr, nullptr, own);
 }
 
 }  // namespace mmpm

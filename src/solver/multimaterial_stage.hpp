@@ -78,18 +78,18 @@ class MultimaterialStage {
     if (!enabled_) return;
     cfg_.dt = Real(dt);
     stats_.reset(fields_);
-    multimaterial_pass_a(grid, list_, cfg_, stats_, stick_flags_, own);
+    multimaterial_pass_a(grid, list_, cfg_, stats_, stick_flags_, own, &geometry_);
   }
   // record_reactions = false for MUSL's repeat of pass B on the
   // re-extrapolated momenta: the step's impulse on rigid bodies is already counted.
   void pass_b(GridView<D, Real>& grid, const NodeOwnership& own, bool record_reactions = true) {
     if (!enabled_) return;
     if (record_reactions) {
-      multimaterial_pass_b(grid, list_, cfg_, stick_flags_, stats_, own);
+      multimaterial_pass_b(grid, list_, cfg_, stick_flags_, stats_, own, &geometry_);
       return;
     }
     const auto kept = stats_.rigid_reaction;
-    multimaterial_pass_b(grid, list_, cfg_, stick_flags_, stats_, own);
+    multimaterial_pass_b(grid, list_, cfg_, stick_flags_, stats_, own, &geometry_);
     stats_.rigid_reaction = kept;
   }
 
@@ -118,6 +118,7 @@ class MultimaterialStage {
   MMStats stats_;
   std::vector<std::uint32_t> list_;
   std::vector<unsigned char> stick_flags_;
+  std::vector<SavedGeometry<D, Real>> geometry_;  // pass A's, for pass B
 };
 
 }  // namespace mmpm
