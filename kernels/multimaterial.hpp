@@ -550,8 +550,8 @@ void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::si
   for (int ia = 0; ia < K; ++ia) apply(nf.field[ia], change[ia], force[ia], Real(1));
 }
 
-// The chunks of the list from `first` to `last`, each taken by one thread
-// through a shared cursor.
+// A run of chunks [next, last) of the list; threads take them one at a time
+// by advancing `next`.
 struct alignas(64) ChunkCursor {
   std::atomic<std::size_t> next{0};
   std::size_t last = 0;
