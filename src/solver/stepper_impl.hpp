@@ -225,27 +225,21 @@ void Stepper<D, Shape, Real>::update_node_ownership(bool rebuilt) {
 
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::zero_grid(bool mm) {
-  // One region for every array, each thread zeroing the nodes it owns.
-  constexpr std::size_t N = 1 + 2 * D;
-  std::array<Real*, N> base{G_.m};
-  for (int d = 0; d < D; ++d)
-    base[std::size_t(1 + d)] = G_.p[d], base[std::size_t(1 + D + d)] = G_.f[d];
-  // The multimaterial arrays: fi always; mx, vol, g only when this step's
-  // first P2G scatters them, else p2g_multimaterial zeroes what it writes.
-  constexpr std::size_t M = 1 + 3 * D;
-  std::array<Real*, M> extra{};
+  // One region for every array, each thread zeroing the nodes it owns. The
+  // multimaterial arrays: fi always; mx, vol, g only when this step's first
+  // P2G scatters them, else p2g_multimaterial zeroes what it writes.
+  std::array<Real*, 2 + 5 * D> arrays{};  // null entries are skipped
+  std::size_t k = 0;
+  arrays[k++] = G_.m;
+  for (int d = 0; d < D; ++d) arrays[k++] = G_.p[d], arrays[k++] = G_.f[d];
   if (mm) {
-    for (int d = 0; d < D; ++d) extra[std::size_t(d)] = G_.fi[d];
+    for (int d = 0; d < D; ++d) arrays[k++] = G_.fi[d];
     if (mm_fields_with_p2g_) {
-      extra[D] = G_.vol;
-      for (int d = 0; d < D; ++d)
-        extra[std::size_t(D + 1 + d)] = G_.mx[d], extra[std::size_t(2 * D + 1 + d)] = G_.g[d];
+      arrays[k++] = G_.vol;
+      for (int d = 0; d < D; ++d) arrays[k++] = G_.mx[d], arrays[k++] = G_.g[d];
     }
   }
-  std::array<Real*, N + M> all{};
-  std::copy(base.begin(), base.end(), all.begin());
-  std::copy(extra.begin(), extra.end(), all.begin() + N);
-  zero_owned(own_, G_.nodes, G_.fields, all);
+  zero_owned(own_, G_.nodes, G_.fields, arrays);
 }
 
 template <int D, class Shape, class Real>
