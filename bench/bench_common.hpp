@@ -26,6 +26,7 @@
 #include "kernels/g2p.hpp"
 #include "kernels/grid_update.hpp"
 #include "kernels/grid_view.hpp"
+#include "kernels/node_ownership.hpp"
 #include "kernels/p2g.hpp"
 #include "kernels/particle_view.hpp"
 #include "kernels/reduce.hpp"
@@ -63,6 +64,21 @@ std::array<double, 7> set_stage_counters(benchmark::State& state,
 // The whole-step two-layer scene (bench_step.cpp), shared with bench_mm_scene.cpp.
 Simulation& two_layer_interface_simulation();
 Scheme two_layer_interface_scheme();
+
+// dst <- src for an array of fields x nodes, each thread copying the nodes
+// it owns under an even NodeOwnership (kernels/node_ownership.hpp), as the
+// solver's node loops do: restoring a grid array on one thread between
+// iterations would leave it in that core's cache, which is not where the
+// step leaves it, and make a multi-thread measurement of the next pass
+// pay for cache-line transfers the solver does not have.
+template <class Real>
+inline void restore_owned(Real* dst, const Real* src, std::size_t nodes, int fields) {
+  const NodeOwnership even;
+#pragma omp parallel if (nodes * std::size_t(fields) >= kParallelMin)
+  for_own_nodes(even, nodes, fields, [&](std::size_t b, std::size_t e) {
+    std::memcpy(dst + b, src + b, (e - b) * sizeof(Real));
+  });
+}
 
 template <class Real>
 inline const char* real_name() {

@@ -100,10 +100,9 @@ MMFixture<D, Real>& mm_fixture() {
 template <int D, class Real>
 void restore(MMFixture<D, Real>& fx) {
   const GridView<D, Real>& G = fx.grid.G;
-  const std::size_t bytes = fx.grid.size() * sizeof(Real);
   for (int d = 0; d < D; ++d) {
-    std::memcpy(G.p[d], fx.pristine[std::size_t(d)].data(), bytes);
-    std::memcpy(G.fi[d], fx.pristine[std::size_t(D + d)].data(), bytes);
+    restore_owned(G.p[d], fx.pristine[std::size_t(d)].data(), G.nodes, G.fields);
+    restore_owned(G.fi[d], fx.pristine[std::size_t(D + d)].data(), G.nodes, G.fields);
   }
 }
 

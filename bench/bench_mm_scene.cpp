@@ -71,8 +71,8 @@ void bm_mm_scene(benchmark::State& state, int threads) {
     double t_find = 0, t_a = 0, t_b = 0;
     for (auto _ : state) {
       for (int d = 0; d < 2; ++d) {
-        std::memcpy(G.p[d], saved[std::size_t(d)].data(), total * sizeof(double));
-        std::memcpy(G.fi[d], saved[std::size_t(2 + d)].data(), total * sizeof(double));
+        restore_owned(G.p[d], saved[std::size_t(d)].data(), G.nodes, G.fields);
+        restore_owned(G.fi[d], saved[std::size_t(2 + d)].data(), G.nodes, G.fields);
       }
       const auto t0 = Clock::now();
       find_multimaterial_nodes(G, cfg.mass_threshold, list);
