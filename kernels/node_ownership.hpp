@@ -3,7 +3,8 @@
 //
 // Why: the two cores of this machine do not share a cache level that is
 // quick to reach; a cache line one core wrote costs the other ~200 ns to
-// read (tools: a ping-pong of one line, 400 ns round trip). The colored
+// read (one line ping-ponged between the two CPUs: ~400 ns per round trip,
+// docs/performance.md "Threads keep their nodes"). The colored
 // P2G writes the nodes around each thread's tiles, and the G2P reads them
 // back from the same tiles (kernels/binning.hpp TileSchedule), so a node
 // loop that splits the nodes any other way hands about half of every grid
@@ -37,8 +38,6 @@ struct NodeOwnership {
   // threads + 1 ascending node indices, split[0] = 0, split[threads] = nodes;
   // empty: an even split.
   std::vector<std::size_t> split;
-
-  std::size_t threads() const { return split.empty() ? 0 : split.size() - 1; }
 
   // Nodes [first, last) of thread i of `threads`. A team of another size
   // than the split was made for (a loop below its parallel threshold runs
