@@ -14,6 +14,7 @@
 
 #include "bench/bench_common.hpp"
 #include "kernels/multimaterial.hpp"
+#include "scene/format.hpp"
 
 namespace mmpm::bench {
 namespace {
@@ -106,37 +107,6 @@ void restore(MMFixture<D, Real>& fx) {
   }
 }
 
-const char* law_name(Law l) {
-  switch (l) {
-    case Law::stick:
-      return "stick";
-    case Law::frictionless:
-      return "frictionless";
-    case Law::friction:
-      return "friction";
-    case Law::interface:
-      return "interface";
-    case Law::separate:
-      return "separate";
-  }
-  return "?";
-}
-const char* normal_name(NormalMethod m) {
-  switch (m) {
-    case NormalMethod::mvg:
-      return "mvg";
-    case NormalMethod::avg:
-      return "avg";
-    case NormalMethod::specified:
-      return "specified";
-    case NormalMethod::radial:
-      return "radial";
-    case NormalMethod::rigid:
-      return "rigid";
-  }
-  return "?";
-}
-
 template <int D, class Real>
 void bm_mm(benchmark::State& state, Law law, NormalMethod normal, int threads) {
   use_threads(threads);
@@ -213,8 +183,9 @@ void register_dim() {
     for (NormalMethod normal :
          {NormalMethod::mvg, NormalMethod::avg, NormalMethod::specified, NormalMethod::radial})
       for (int threads : {1, 2}) {
-        const std::string name = "mm/dim:" + std::to_string(D) + "/law:" + law_name(law) +
-                                 "/normal:" + normal_name(normal) +
+        const std::string name = "mm/dim:" + std::to_string(D) +
+                                 "/law:" + std::string(scene_name(law)) +
+                                 "/normal:" + std::string(scene_name(normal)) +
                                  "/real:double/threads:" + std::to_string(threads);
         auto* b = benchmark::RegisterBenchmark(name.c_str(),
                                                [law, normal, threads](benchmark::State& st) {
