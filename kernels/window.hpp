@@ -29,6 +29,7 @@
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <cstring>
 #include <utility>
 
 #include "kernels/grid_view.hpp"
@@ -126,12 +127,6 @@ struct Window {
       return yz<u>(wa, dwa);
   }
 
-  // Lane d * W + k = lane d of t.
-  template <std::size_t... I>
-  static VA spread(const VA& t, std::index_sequence<I...>) {
-    return __builtin_shufflevector(t, t, int(I / W)...);
-  }
-
  private:
   // Lanes of a picked by a constexpr index function of the unit lane.
   template <class F, std::size_t... I>
@@ -183,17 +178,28 @@ class WindowBuilder {
   using Win = Window<D, Shape, Real>;
   static constexpr int W = Win::W, DP = Win::DP;
   using VA = typename Win::VA;
+  // The shape function runs on parts of VA of at most one 64-byte register.
+  // Why: GCC lowers the compares and selects of a vector wider than the
+  // machine's (3D W = 4 in double: 16 lanes, two registers) lane by lane,
+  // each lane through the stack; the uGIMP clamps then cost more than the
+  // rest of the transfer (3D uGIMP double P2G 115 ns/particle vs 33 in
+  // float, whose VA is one register).
+  static constexpr int kParts = sizeof(VA) > 64 ? int(sizeof(VA) / 64) : 1;
+  static constexpr int PL = W * DP / kParts;  // lanes per part
+  using Part = Lanes<Real, PL>;
 
   explicit WindowBuilder(const GridView<D, Real>& G) {
-    VA ih{};
-    for (int d = 0; d < DP; ++d) {
-      ih[d] = d < D ? Real(1) / G.h[std::size_t(d)] : Real(1);
-      if (d < D)
-        inv_h[d] = ih[d], origin[d] = G.origin[std::size_t(d)],
-        n[d] = G.nodes_per_dim[std::size_t(d)];
+    for (int d = 0; d < D; ++d) {
+      inv_h[d] = Real(1) / G.h[std::size_t(d)];
+      origin[d] = G.origin[std::size_t(d)];
+      n[d] = G.nodes_per_dim[std::size_t(d)];
     }
-    inv_h_lanes = Win::spread(ih, std::make_index_sequence<W * DP>{});
-    for (int k = 0; k < W * DP; ++k) offsets_lanes[k] = Real(-(k % W));
+    for (int k = 0; k < W * DP; ++k) {
+      const int d = k / W;  // lane k: direction d, node k % W
+      inv_h_lanes[k / PL][k % PL] = d < D ? inv_h[d] : Real(1);
+      offsets_lanes[k / PL][k % PL] = Real(-(k % W));
+      direction_lanes[k / PL][k % PL] = Real(d);
+    }
   }
 
   // The window of particle p into w; false when the particle's stencil
@@ -204,7 +210,7 @@ class WindowBuilder {
     // floor(xi - 1/2)), cubic [1, n - 2).
     constexpr Real lo_xi = Shape::W == 2 ? Real(0) : (Shape::S == 3 ? Real(0.5) : Real(1));
     constexpr Real hi_margin = Shape::W == 2 ? Real(1) : (Shape::S == 3 ? Real(1.5) : Real(2));
-    VA r{}, l{};
+    Real r[DP], l[DP];
     std::size_t stride = 1;
     std::size_t base = 0;
     for (int d = 0; d < D; ++d) {
@@ -220,17 +226,46 @@ class WindowBuilder {
     }
     if constexpr (DP > D)
       r[DP - 1] = Real(0.5), l[DP - 1] = Real(0.25);  // padding: any harmless distance
-    constexpr auto seq = std::make_index_sequence<W * DP>{};
-    Shape::lanes(Win::spread(r, seq) + offsets_lanes, Win::spread(l, seq), w.wa, w.dwa);
-    w.dwa *= inv_h_lanes;
+    if constexpr (kParts == 1) {
+      // One register: lanes set one by one, then spread by one shuffle.
+      VA rv{}, lv{};
+      for (int d = 0; d < DP; ++d) rv[d] = r[d], lv[d] = l[d];
+      constexpr auto seq = std::make_index_sequence<W * DP>{};
+      Shape::lanes(spread(rv, seq) + offsets_lanes[0], spread(lv, seq), w.wa, w.dwa);
+      w.dwa *= inv_h_lanes[0];
+    } else {
+      // Two registers: filling the wide vector lane by lane went through the
+      // stack, and its load then waited on the scalar stores (a failed
+      // store-to-load forward), so each part is set by broadcasts and
+      // selects on constant masks.
+      static_for<kParts>([&](auto hc) {
+        constexpr int h = decltype(hc)::value;
+        Part pw, pdw;
+        Shape::lanes(per_direction(r, h) + offsets_lanes[h], per_direction(l, h), pw, pdw);
+        pdw *= inv_h_lanes[h];
+        std::memcpy(reinterpret_cast<char*>(&w.wa) + h * sizeof(Part), &pw, sizeof(Part));
+        std::memcpy(reinterpret_cast<char*>(&w.dwa) + h * sizeof(Part), &pdw, sizeof(Part));
+      });
+    }
     w.base = base;
     return true;
   }
 
  private:
+  // Lane d * W + k = lane d of t.
+  template <std::size_t... I>
+  static VA spread(const VA& t, std::index_sequence<I...>) {
+    return __builtin_shufflevector(t, t, int(I / W)...);
+  }
+  // Lane k of part h = v[direction of lane h * PL + k].
+  [[gnu::always_inline]] Part per_direction(const Real (&v)[DP], int h) const {
+    Part out = Part{} + v[DP - 1];
+    for (int d = DP - 2; d >= 0; --d) out = direction_lanes[h] == Real(d) ? Part{} + v[d] : out;
+    return out;
+  }
   Real inv_h[D]{}, origin[D]{};
   int n[D]{};
-  VA inv_h_lanes{}, offsets_lanes{};
+  Part inv_h_lanes[kParts]{}, offsets_lanes[kParts]{}, direction_lanes[kParts]{};
 };
 
 }  // namespace mmpm

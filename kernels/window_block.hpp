@@ -38,16 +38,23 @@ struct ScatterSource {
   Real mw[D] = {};   // mass times displacement (or position)
 };
 
-template <int D, class Shape, class Real, unsigned What, bool Traction>
+// Sums for UG units of the window (all of them by default); the member
+// templates take the first unit U0 of the group (kernels/p2g.hpp splits the
+// window into groups when one block would not fit in the registers).
+template <int D, class Shape, class Real, unsigned What, bool Traction,
+          int UG = Window<D, Shape, Real>::units>
 struct WindowBlock {
   using Win = Window<D, Shape, Real>;
   using V = typename Win::V;
-  static constexpr int U = Win::units;
+  static constexpr int U = UG;
   static constexpr bool kMass = (What & kMassMomentum) != 0;
   static constexpr bool kMom = (What & (kMassMomentum | kMomentumOnly)) != 0;
   static constexpr bool kFrc = (What & kForce) != 0;
   static constexpr bool kMM = (What & kMultimaterial) != 0;
   static constexpr bool kGrad = kMM && (What & kDomainGradient) != 0;
+  // Vectors summed per unit.
+  static constexpr int kQuantities =
+      int(kMass) + (kMom ? D : 0) + (kFrc ? D : 0) + (kMM ? 1 + D : 0) + (kGrad ? D : 0);
 
   V am[U], ap[D][U], af[D][U], avol[U], amx[D][U], ag[D][U];
   std::size_t current = SIZE_MAX;  // window base (with field offset) the block holds
@@ -68,39 +75,42 @@ struct WindowBlock {
   }
 
   // Adds the block to the grid at `current` (if it holds anything).
+  template <int U0 = 0>
   void flush(const GridView<D, Real>& G, const typename Win::Offsets& off) {
     if (current == SIZE_MAX) return;
     const std::size_t b = current;
     static_for<U>([&](auto uc) {
-      constexpr int u = decltype(uc)::value;
-      if constexpr (kMass) Win::template add<u>(G.m + b, off, am[u]);
+      constexpr int u = decltype(uc)::value, wu = U0 + u;  // block unit, window unit
+      if constexpr (kMass) Win::template add<wu>(G.m + b, off, am[u]);
       for (int d = 0; d < D; ++d) {
-        if constexpr (kMom) Win::template add<u>(G.p[d] + b, off, ap[d][u]);
-        if constexpr (kFrc) Win::template add<u>(G.f[d] + b, off, af[d][u]);
-        if constexpr (kMM) Win::template add<u>(G.mx[d] + b, off, amx[d][u]);
-        if constexpr (kGrad) Win::template add<u>(G.g[d] + b, off, ag[d][u]);
+        if constexpr (kMom) Win::template add<wu>(G.p[d] + b, off, ap[d][u]);
+        if constexpr (kFrc) Win::template add<wu>(G.f[d] + b, off, af[d][u]);
+        if constexpr (kMM) Win::template add<wu>(G.mx[d] + b, off, amx[d][u]);
+        if constexpr (kGrad) Win::template add<wu>(G.g[d] + b, off, ag[d][u]);
       }
-      if constexpr (kMM) Win::template add<u>(G.vol + b, off, avol[u]);
+      if constexpr (kMM) Win::template add<wu>(G.vol + b, off, avol[u]);
     });
   }
 
   // Moves the block to window base b, writing out what it held before.
+  template <int U0 = 0>
   void at(std::size_t b, const GridView<D, Real>& G, const typename Win::Offsets& off) {
     if (b == current) return;
     if (current != SIZE_MAX) {
-      flush(G, off);
+      flush<U0>(G, off);
       clear();
     }
     current = b;
   }
 
+  template <int U0 = 0>
   void accumulate(const Win& win, const ScatterSource<D, Real>& q) {
     const V X = win.X(), GXl = win.GX();
     static_for<U>([&](auto uc) {
-      constexpr int u = decltype(uc)::value;
-      const V Yu = win.template Y<u>();
+      constexpr int u = decltype(uc)::value, wu = U0 + u;  // block unit, window unit
+      const V Yu = win.template Y<wu>();
       const V s = X * Yu;
-      const V Gx = GXl * Yu, Gy = X * win.template GY<u>();
+      const V Gx = GXl * Yu, Gy = X * win.template GY<wu>();
       if constexpr (kMass) am[u] += s * q.m;
       if constexpr (kMom)
         for (int d = 0; d < D; ++d) ap[d][u] += s * q.mv[d];
@@ -110,7 +120,7 @@ struct WindowBlock {
           af[0][u] -= q.vs[0] * Gx + q.vs[2] * Gy;
           af[1][u] -= q.vs[2] * Gx + q.vs[1] * Gy;
         } else {
-          const V Gz = X * win.template GZ<u>();
+          const V Gz = X * win.template GZ<wu>();
           af[0][u] -= q.vs[0] * Gx + q.vs[5] * Gy + q.vs[4] * Gz;
           af[1][u] -= q.vs[5] * Gx + q.vs[1] * Gy + q.vs[3] * Gz;
           af[2][u] -= q.vs[4] * Gx + q.vs[3] * Gy + q.vs[2] * Gz;
@@ -125,7 +135,7 @@ struct WindowBlock {
       if constexpr (kGrad) {
         ag[0][u] += Gx * q.area;
         ag[1][u] += Gy * q.area;
-        if constexpr (D == 3) ag[2][u] += (X * win.template GZ<u>()) * q.area;
+        if constexpr (D == 3) ag[2][u] += (X * win.template GZ<wu>()) * q.area;
       }
     });
   }

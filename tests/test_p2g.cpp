@@ -651,6 +651,70 @@ TYPED_TEST(P2G, WindowedScatterMatchesPointwiseAtGridEdgesUnsorted) {
 
 // A particle whose stencil leaves the grid is reported by both kernels at
 // the same index.
+// The grouped scatter (kernels/p2g.hpp: the window's units in groups of UG,
+// each batch scattered once per group, a group's open block carried to the
+// next batch) against the one-block scatter: bitwise the same arrays, for
+// every group size, with tile-sorted particles (runs of a few per window)
+// and with 100 particles in one cell (a run longer than a weight batch).
+// Also stops at the same particle off the grid, with the sums before it.
+template <int D, class Shape, class Real, unsigned What, bool MF, bool TR, int UG>
+void check_grouped_matches_one_block(Particles<D, Real> p, std::size_t stop_at) {
+  const bool gimp = std::string(Shape::name) == "gimp";
+  Grid<D, Real> one(grid_cells<D>(), 2), grouped(grid_cells<D>(), 2);
+  const auto P = p.view(gimp);
+  P2GOptions opt;
+  opt.inv_thickness = 0.5;
+  const std::size_t n = p.n;
+  const std::size_t expect = std::min(stop_at, n);
+  ASSERT_EQ((p2g_range_one_block<D, Shape, Real, What, MF, TR>(P, one.G, opt, 0, n)), expect);
+  ASSERT_EQ((p2g_range_grouped<D, Shape, Real, What, MF, TR, UG>(P, grouped.G, opt, 0, n)), expect);
+  for (std::size_t a = 0; a < one.arrays.size(); ++a)
+    for (std::size_t i = 0; i < one.arrays[a].size(); ++i)
+      ASSERT_EQ(std::memcmp(&one.arrays[a][i], &grouped.arrays[a][i], sizeof(Real)), 0)
+          << "UG " << UG << ", What " << What << ", array " << a << ", entry " << i << ": "
+          << double(one.arrays[a][i]) << " vs " << double(grouped.arrays[a][i]);
+}
+
+template <int D, class Shape, class Real, int UG>
+void check_grouped_all_quantities(const Particles<D, Real>& p, std::size_t stop_at) {
+  check_grouped_matches_one_block<D, Shape, Real, kAll, true, true, UG>(p, stop_at);
+  check_grouped_matches_one_block<D, Shape, Real, kMassMomentum | kForce, false, false, UG>(
+      p, stop_at);
+  check_grouped_matches_one_block<D, Shape, Real, kMultimaterial | kDomainGradient, true, false,
+                                  UG>(p, stop_at);
+  check_grouped_matches_one_block<D, Shape, Real, kMomentumOnly, true, false, UG>(p, stop_at);
+}
+
+TYPED_TEST(P2G, GroupedScatterGivesTheOneBlockSumsBitwise) {
+  constexpr int D = TypeParam::D;
+  using Shape = typename TypeParam::Shape;
+  using Real = typename TypeParam::Real;
+  constexpr int U = Window<D, Shape, Real>::units;
+  Grid<D, Real> g(grid_cells<D>(), 2);
+  TileLayout<D> tiles;
+  tiles.setup(4, g.cells);
+  auto random = random_particles<D, Real>(g.G, g.cells, D == 2 ? 6000 : 4000, 901);
+  auto sorted = random.permuted(sort_by_tile(random, g.G, tiles));
+  // 100 particles in one cell of field 1, then the sorted ones.
+  auto crowded = random_particles<D, Real>(g.G, g.cells, 100, 902);
+  for (std::size_t i = 0; i < crowded.n; ++i) {
+    crowded.field[i] = 1;
+    for (int d = 0; d < D; ++d)
+      crowded.x[d][i] =
+          Real(double(g.G.origin[d]) + (5.3 + 0.4 * double(i % 7) / 7.0) * double(g.G.h[d]));
+  }
+  // The same list with one particle moved off the grid: both kernels stop there.
+  auto off_grid = sorted;
+  const std::size_t bad = 1234;
+  off_grid.x[0][bad] = Real(-1e6);
+  for (const auto* list : {&sorted, &crowded, &off_grid}) {
+    const std::size_t stop_at = list == &off_grid ? bad : SIZE_MAX;
+    check_grouped_all_quantities<D, Shape, Real, 1>(*list, stop_at);
+    if constexpr (U >= 2) check_grouped_all_quantities<D, Shape, Real, U / 2>(*list, stop_at);
+    if constexpr (U >= 4) check_grouped_all_quantities<D, Shape, Real, 2>(*list, stop_at);
+  }
+}
+
 TYPED_TEST(P2G, WindowedScatterReportsTheSameParticleOffTheGrid) {
   constexpr int D = TypeParam::D;
   using Shape = typename TypeParam::Shape;
