@@ -174,8 +174,24 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
   const auto off =
       Windowed ? Window<D, Shape, Real>::offsets(G) : typename Window<D, Shape, Real>::Offsets{};
   using Weights = typename G2PGather<D, Shape, Real, Windowed>::Weights;
+  // When the momentum block and the gather's sums (2D vectors) do not fit in
+  // the registers together (3D uGIMP and B-splines in double: 24 + 6), the
+  // momenta of a batch are scattered after its gathers, by GroupedScatter
+  // (kernels/window_block.hpp), from the same windows: the same sums in the
+  // same order. A particle off the grid ends the batch's scatter there (the
+  // step fails on it anyway).
+  constexpr int kUnits = Window<D, Shape, Real>::units;
+  constexpr bool kDefer = kScatter && Windowed && D * kUnits + 2 * D > kBlockRegisterBudget;
+  constexpr int kDeferUG = block_group_units<D, Shape, Real, kMomentumOnly, false>();
+  struct NoDeferred {
+    explicit NoDeferred(const GridView<D, Real>&) {}
+  };
+  std::conditional_t<kDefer, GroupedScatter<D, Shape, Real, kMomentumOnly, false, kDeferUG>,
+                     NoDeferred>
+      deferred(G);
   auto scatter_momentum = [&](const Weights& w, std::size_t p, std::size_t fo)
       __attribute__((always_inline)) {
+    if constexpr (kDefer) return;  // after the batch
     ScatterSource<D, Real> s;
     for (int d = 0; d < D; ++d) s.mv[d] = P.m[p] * P.v[d][p];
     if constexpr (Windowed) {
@@ -244,8 +260,24 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
       for (int d = 0; d < D; ++d) P.x[d][p] = P.x_next[d][p];
     return true;
   };
-  for_each_weighted<Weights>(begin, end, build, transfer);
-  if constexpr (kScatter && Windowed) block.flush(G, off);
+  auto after_batch = [&](std::size_t first, std::size_t n, const Weights* w, const bool* ok) {
+    if constexpr (kDefer) {
+      std::size_t base[kWeightBatch];
+      ScatterSource<D, Real> s[kWeightBatch];
+      std::size_t count = 0;
+      for (; count < n && ok[count]; ++count) {
+        const std::size_t p = first + count;
+        base[count] = w[count].base + (MultiField ? std::size_t(P.field[p]) * G.nodes : 0);
+        for (int d = 0; d < D; ++d) s[count].mv[d] = P.m[p] * P.v[d][p];
+      }
+      deferred.add(w, base, s, count, count == n && first + n < end);
+    }
+  };
+  for_each_weighted<Weights>(begin, end, build, transfer, after_batch);
+  if constexpr (kDefer)
+    deferred.finish();
+  else if constexpr (kScatter && Windowed)
+    block.flush(G, off);
   // Positions moved in this pass (in place, or committed from x_next): did a
   // particle leave its tile? One vectorised test of the range, after the loop.
   constexpr bool kMoves = (What & (kCommitPosition | kUpdateMotion)) != 0;

@@ -100,36 +100,12 @@ template <int D, class Real, unsigned What, bool Traction>
   return q;
 }
 
-// Vector accumulators one window block may keep in registers: AVX-512 has
-// 32, and the weights and factors of the particle need a few.
-#ifdef __AVX512F__
-inline constexpr int kBlockRegisterBudget = 28;
-#else
-inline constexpr int kBlockRegisterBudget = 6;  // a unit is two AVX2 registers
-#endif
-
-// Units per block group: all of the window's units when their sums fit in
-// the registers, else the largest power of two that does (3D uGIMP and
-// B-splines in double: 64 nodes x 7 quantities = 56 vectors).
-template <int D, class Shape, class Real, unsigned What, bool Traction>
-constexpr int block_group_units() {
-  constexpr int q = WindowBlock<D, Shape, Real, What, Traction, 1>::kQuantities;
-  int g = Window<D, Shape, Real>::units;
-  while (g > 1 && g * q > kBlockRegisterBudget) g /= 2;
-  return g;
-}
-
-// The windowed scatter for blocks that do not fit in the registers: the
-// window's units are split into groups of UG, and each run of particles
-// with the same window (consecutive in the binning order) is scattered once
-// per group, so each group's sums stay in registers (one block of all units
-// spilled to the stack: every particle then loaded and stored every sum,
-// 3D uGIMP double P2G 80 -> 62 ns/particle). Runs are taken whole, in order,
-// and a run cut by the end of a weight batch (kernels/weight_batch.hpp)
-// carries its blocks into the next batch: every node gets the same sums in
-// the same order as with one block, so results are bitwise equal
-// (tests/test_p2g.cpp; scattering group by group over a whole batch would
-// reorder the adds of overlapping windows). The caller has checked
+// The windowed scatter for blocks that do not fit in the registers
+// (GroupedScatter, kernels/window_block.hpp): each run of particles with the
+// same window is scattered once per group of UG units, so each group's sums
+// stay in registers. One block of all units spilled to the stack: every
+// particle then loaded and stored every sum (3D uGIMP double P2G 80 -> 67
+// ns/particle). Bitwise the one-block sums. The caller has checked
 // Window::fits. Returns as p2g_range.
 template <int D, class Shape, class Real, unsigned What, bool MultiField, bool Traction, int UG>
 std::size_t p2g_range_grouped(const ParticleView<D, Real>& particles, const GridView<D, Real>& grid,
@@ -137,25 +113,12 @@ std::size_t p2g_range_grouped(const ParticleView<D, Real>& particles, const Grid
   const ParticleView<D, Real> P = particles;
   const GridView<D, Real> G = grid;
   using Win = Window<D, Shape, Real>;
-  using Block = WindowBlock<D, Shape, Real, What, Traction, UG>;
-  constexpr int kGroups = Win::units / UG;
-  static_assert(kGroups * UG == Win::units);
   const Real inv_t = Real(opt.inv_thickness);
-  const auto off = Win::offsets(G);
   const WindowBuilder<D, Shape, Real> builder(G);
+  GroupedScatter<D, Shape, Real, What, Traction, UG> scatter(G);
   Win w[kWeightBatch];
   ScatterSource<D, Real> q[kWeightBatch];
   std::size_t base[kWeightBatch];
-  Block carried[kGroups];  // each group's sums of the run the last batch ended in
-  bool carrying = false;
-  auto flush_carried = [&] {
-    static_for<kGroups>([&](auto gc) {
-      constexpr int g = decltype(gc)::value;
-      carried[g].template flush<g * UG>(G, off);
-      carried[g].clear();
-    });
-    carrying = false;
-  };
   for (std::size_t first = begin; first < end; first += kWeightBatch) {
     const std::size_t n = std::min(kWeightBatch, end - first);
     std::size_t ok = 0;
@@ -164,29 +127,10 @@ std::size_t p2g_range_grouped(const ParticleView<D, Real>& particles, const Grid
       base[i] = w[i].base + (MultiField ? std::size_t(P.field[first + i]) * G.nodes : 0);
       q[i] = scatter_source<D, Real, What, Traction>(P, opt, inv_t, first + i);
     }
-    if (carrying && (ok == 0 || base[0] != carried[0].current)) flush_carried();
-    for (std::size_t i = 0; i < ok;) {
-      std::size_t j = i + 1;
-      while (j < ok && base[j] == base[i]) ++j;
-      const bool resume = i == 0 && carrying;
-      const bool cut = j == n && first + n < end;  // the run may go on in the next batch
-      static_for<kGroups>([&](auto gc) {
-        constexpr int g = decltype(gc)::value;
-        Block block;  // a local the compiler keeps in registers
-        if (resume) block = carried[g];
-        block.current = base[i];
-        for (std::size_t k = i; k < j; ++k) block.template accumulate<g * UG>(w[k], q[k]);
-        if (cut)
-          carried[g] = block;
-        else
-          block.template flush<g * UG>(G, off);
-      });
-      carrying = cut;
-      i = j;
-    }
-    if (ok < n) return first + ok;  // nothing carried: a cut run needs a full batch
+    scatter.add(w, base, q, ok, ok == n && first + n < end);
+    if (ok < n) return first + ok;  // nothing carried: `more` was false
   }
-  if (carrying) flush_carried();
+  scatter.finish();
   return end;
 }
 

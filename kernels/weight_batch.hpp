@@ -24,10 +24,13 @@ inline constexpr std::size_t kWeightBatch = 32;
 
 // For p in [begin, end): build(p, w) fills w and says whether p is on the
 // grid, then body(p, w or nullptr) runs the transfer and says whether to go
-// on. Returns the particle the body stopped at, or end.
-template <class Weights, class Build, class Body>
+// on; after each batch, after_batch(first, n, w, ok) sees the batch's
+// windows (a second pass over them, kernels/g2p.hpp). Returns the particle
+// the body stopped at, or end.
+template <class Weights, class Build, class Body, class AfterBatch>
 [[gnu::always_inline]] inline std::size_t for_each_weighted(std::size_t begin, std::size_t end,
-                                                            Build&& build, Body&& body) {
+                                                            Build&& build, Body&& body,
+                                                            AfterBatch&& after_batch) {
   Weights w[kWeightBatch];
   bool ok[kWeightBatch];
   for (std::size_t first = begin; first < end; first += kWeightBatch) {
@@ -35,8 +38,16 @@ template <class Weights, class Build, class Body>
     for (std::size_t i = 0; i < n; ++i) ok[i] = build(first + i, w[i]);
     for (std::size_t i = 0; i < n; ++i)
       if (!body(first + i, ok[i] ? &w[i] : nullptr)) return first + i;
+    after_batch(first, n, static_cast<const Weights*>(w), static_cast<const bool*>(ok));
   }
   return end;
+}
+
+template <class Weights, class Build, class Body>
+[[gnu::always_inline]] inline std::size_t for_each_weighted(std::size_t begin, std::size_t end,
+                                                            Build&& build, Body&& body) {
+  return for_each_weighted<Weights>(begin, end, build, body,
+                                    [](std::size_t, std::size_t, const Weights*, const bool*) {});
 }
 
 }  // namespace mmpm

@@ -141,4 +141,86 @@ struct WindowBlock {
   }
 };
 
+// Vector accumulators one window block may keep in registers: AVX-512 has
+// 32, and the weights and factors of the particle need a few.
+#ifdef __AVX512F__
+inline constexpr int kBlockRegisterBudget = 28;
+#else
+inline constexpr int kBlockRegisterBudget = 6;  // a unit is two AVX2 registers
+#endif
+
+// Units per block group: all of the window's units when their sums fit in
+// the registers, else the largest power of two that does (3D uGIMP and
+// B-splines in double: 64 nodes x 7 quantities = 56 vectors).
+template <int D, class Shape, class Real, unsigned What, bool Traction>
+constexpr int block_group_units() {
+  constexpr int q = WindowBlock<D, Shape, Real, What, Traction, 1>::kQuantities;
+  int g = Window<D, Shape, Real>::units;
+  while (g > 1 && g * q > kBlockRegisterBudget) g /= 2;
+  return g;
+}
+
+// Scatters windows a batch at a time with the window's units in groups of
+// UG, each group's sums in registers (kernels/p2g.hpp says why). Each run of
+// particles with the same window is taken whole, group after group, and a
+// run cut by the end of a batch carries its sums into the next one, so
+// every node gets the same sums in the same order as with one block of all
+// units: bitwise equal results (tests/test_p2g.cpp). Scattering group by
+// group over a whole batch instead would reorder the adds of overlapping
+// windows.
+template <int D, class Shape, class Real, unsigned What, bool Traction, int UG>
+class GroupedScatter {
+ public:
+  using Win = Window<D, Shape, Real>;
+  using Block = WindowBlock<D, Shape, Real, What, Traction, UG>;
+  static constexpr int kGroups = Win::units / UG;
+  static_assert(kGroups * UG == Win::units);
+
+  explicit GroupedScatter(const GridView<D, Real>& G) : G_(G), off_(Win::offsets(G)) {}
+
+  // Windows w[0, count) in particle order, with their bases (field offset
+  // included) and sources; `more`: particles follow, so a run reaching
+  // count may go on in the next call.
+  void add(const Win* w, const std::size_t* base, const ScatterSource<D, Real>* q,
+           std::size_t count, bool more) {
+    if (carrying_ && (count == 0 || base[0] != carried_[0].current)) finish();
+    for (std::size_t i = 0; i < count;) {
+      std::size_t j = i + 1;
+      while (j < count && base[j] == base[i]) ++j;
+      const bool resume = i == 0 && carrying_;
+      const bool cut = j == count && more;
+      static_for<kGroups>([&](auto gc) {
+        constexpr int g = decltype(gc)::value;
+        Block block;  // a local the compiler keeps in registers
+        if (resume) block = carried_[g];
+        block.current = base[i];
+        for (std::size_t k = i; k < j; ++k) block.template accumulate<g * UG>(w[k], q[k]);
+        if (cut)
+          carried_[g] = block;
+        else
+          block.template flush<g * UG>(G_, off_);
+      });
+      carrying_ = cut;
+      i = j;
+    }
+  }
+
+  // Writes out a carried run (call once the particles are done).
+  void finish() {
+    if (!carrying_) return;
+    static_for<kGroups>([&](auto gc) {
+      constexpr int g = decltype(gc)::value;
+      carried_[g].template flush<g * UG>(G_, off_);
+      carried_[g].clear();
+    });
+    carrying_ = false;
+  }
+
+ private:
+  GridView<D, Real> G_;
+  typename Win::Offsets off_;
+  Block carried_[kGroups];  // each group's sums of the run the last batch ended in
+  bool carrying_ = false;
+};
+
 }  // namespace mmpm
