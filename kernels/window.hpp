@@ -237,7 +237,9 @@ class WindowBuilder {
       // Two registers: filling the wide vector lane by lane went through the
       // stack, and its load then waited on the scalar stores (a failed
       // store-to-load forward), so each part is set by broadcasts and
-      // selects on constant masks.
+      // selects on constant masks. (A runtime loop over the parts, or
+      // joining them with a shuffle, made GCC 12.2's SLP vectoriser crash on
+      // tests/test_p2g.cpp, and the join measured slower.)
       static_for<kParts>([&](auto hc) {
         constexpr int h = decltype(hc)::value;
         Part pw, pdw;
