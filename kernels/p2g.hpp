@@ -104,7 +104,7 @@ template <int D, class Real, unsigned What, bool Traction>
 // (GroupedScatter, kernels/window_block.hpp): each run of particles with the
 // same window is scattered once per group of UG units, so each group's sums
 // stay in registers. One block of all units spilled to the stack: every
-// particle then loaded and stored every sum (3D uGIMP double P2G 80 -> 67
+// particle then loaded and stored every sum (3D uGIMP double P2G 80 -> 67-75
 // ns/particle). Bitwise the one-block sums. The caller has checked
 // Window::fits. Returns as p2g_range.
 template <int D, class Shape, class Real, unsigned What, bool MultiField, bool Traction, int UG>

@@ -39,8 +39,8 @@ struct ScatterSource {
 };
 
 // Sums for UG units of the window (all of them by default); the member
-// templates take the first unit U0 of the group (kernels/p2g.hpp splits the
-// window into groups when one block would not fit in the registers).
+// templates take the first unit U0 of the group (GroupedScatter below splits
+// the window into groups when one block would not fit in the registers).
 template <int D, class Shape, class Real, unsigned What, bool Traction,
           int UG = Window<D, Shape, Real>::units>
 struct WindowBlock {
