@@ -649,14 +649,14 @@ TYPED_TEST(P2G, WindowedScatterMatchesPointwiseAtGridEdgesUnsorted) {
                                                                                       402);
 }
 
-// A particle whose stencil leaves the grid is reported by both kernels at
-// the same index.
-// The grouped scatter (kernels/p2g.hpp: the window's units in groups of UG,
-// each batch scattered once per group, a group's open block carried to the
+// The grouped scatter (GroupedScatter, kernels/window_block.hpp: the
+// window's units in groups of UG, each run of particles with one window
+// scattered group by group, a run cut by a batch's end carried into the
 // next batch) against the one-block scatter: bitwise the same arrays, for
-// every group size, with tile-sorted particles (runs of a few per window)
-// and with 100 particles in one cell (a run longer than a weight batch).
-// Also stops at the same particle off the grid, with the sums before it.
+// several group sizes, with tile-sorted particles (runs of a few per
+// window) and with 100 particles in one cell (a run longer than a weight
+// batch). Also stops at the same particle off the grid, with the sums
+// before it.
 template <int D, class Shape, class Real, unsigned What, bool MF, bool TR, int UG>
 void check_grouped_matches_one_block(Particles<D, Real> p, std::size_t stop_at) {
   const bool gimp = std::string(Shape::name) == "gimp";
@@ -695,7 +695,7 @@ TYPED_TEST(P2G, GroupedScatterGivesTheOneBlockSumsBitwise) {
   tiles.setup(4, g.cells);
   auto random = random_particles<D, Real>(g.G, g.cells, D == 2 ? 6000 : 4000, 901);
   auto sorted = random.permuted(sort_by_tile(random, g.G, tiles));
-  // 100 particles in one cell of field 1, then the sorted ones.
+  // 100 particles of field 1 in one cell: one run of 100.
   auto crowded = random_particles<D, Real>(g.G, g.cells, 100, 902);
   for (std::size_t i = 0; i < crowded.n; ++i) {
     crowded.field[i] = 1;
@@ -715,6 +715,8 @@ TYPED_TEST(P2G, GroupedScatterGivesTheOneBlockSumsBitwise) {
   }
 }
 
+// A particle whose stencil leaves the grid is reported by both kernels at
+// the same index.
 TYPED_TEST(P2G, WindowedScatterReportsTheSameParticleOffTheGrid) {
   constexpr int D = TypeParam::D;
   using Shape = typename TypeParam::Shape;
