@@ -61,9 +61,10 @@ std::array<double, 7> set_stage_counters(benchmark::State& state,
                                          const std::array<double, 7>& after, double steps,
                                          double particles);
 
-// The whole-step two-layer scene (bench_step.cpp), shared with bench_mm_scene.cpp.
-Simulation& two_layer_interface_simulation();
-Scheme two_layer_interface_scheme();
+// The whole-step scenes of bench_step.cpp that bench_mm_scene.cpp also
+// uses, by name ("2d_gimp_interface", "2d_gimp_inclusions"), and their schemes.
+Simulation& step_scene_simulation(const std::string& scene);
+Scheme step_scene_scheme(const std::string& scene);
 
 // dst <- src for an array of fields x nodes, each thread copying the nodes
 // it owns under an even NodeOwnership (kernels/node_ownership.hpp), as the

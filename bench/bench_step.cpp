@@ -29,6 +29,7 @@
 // default re-binning rarely triggers.
 #include <algorithm>
 #include <map>
+#include <stdexcept>
 
 #include "bench/bench_common.hpp"
 #include "scene/parse.hpp"
@@ -267,6 +268,12 @@ void add(const StepCase& c, int threads) {
   configure(b->UseRealTime()->Unit(benchmark::kMillisecond), 0.6);
 }
 
+StepCase shared_case(const std::string& scene) {
+  if (scene == "2d_gimp_interface") return {scene, two_layer(true, true), {}};
+  if (scene == "2d_gimp_inclusions") return {scene, inclusions_scene(), {}};
+  throw std::invalid_argument("no whole-step scene named " + scene);
+}
+
 }  // namespace
 
 std::array<double, 7> set_stage_counters(benchmark::State& state,
@@ -285,15 +292,13 @@ std::array<double, 7> set_stage_counters(benchmark::State& state,
   return ds;
 }
 
-Scheme two_layer_interface_scheme() {
-  static const Scheme scheme =
-      parse_scene_text(two_layer(true, true), "2d_gimp_interface.toml").simulation.scheme;
-  return scheme;
+Scheme step_scene_scheme(const std::string& scene) {
+  const StepCase c = shared_case(scene);
+  return parse_scene_text(c.text, c.scene + ".toml").simulation.scheme;
 }
 
-Simulation& two_layer_interface_simulation() {
-  static const StepCase c{"2d_gimp_interface", two_layer(true, true), {}};
-  return simulation_for(c);
+Simulation& step_scene_simulation(const std::string& scene) {
+  return simulation_for(shared_case(scene));
 }
 
 void register_step() {

@@ -55,6 +55,9 @@ struct MMConfig {
   // Include Δf_i of (P-27) from grid.f in the force limit and in the exact integration.
   // Off by default (ALGORITHM §2: neglected in pass A).
   bool use_force_difference = false;
+  // Two-material nodes of one pair in SIMD batches (kernels/mm_pair_batch.hpp).
+  // false: every node by the per-node path; the tests compare the two.
+  bool batch_pairs = true;
 };
 
 // Per-step diagnostics. Both passes ADD to it; reset() before pass A of a step.

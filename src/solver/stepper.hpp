@@ -70,6 +70,8 @@ class Stepper final : public Simulation {
   // Exposed for tests and benchmarks.
   ParticleView<D, Real>& particles() { return P_; }
   GridView<D, Real>& grid() { return G_; }
+  MultimaterialStage<D, Real>& multimaterial() { return mm_; }
+  const NodeOwnership& ownership() const { return own_; }
 
  private:
   // The tile test G2P runs on every particle: inline, from copies of the

@@ -1,0 +1,367 @@
+// Two-material nodes of the multimaterial pass, a batch at a time (ALGORITHM
+// §3, §4, §6 with K = 2; docs/multimaterial.md "Two-material nodes in
+// batches"). Most multimaterial nodes hold exactly two deformable materials
+// joined by one interaction. Node by node, each costs a chain of square
+// roots and divisions (normal, tangent, h⊥, area, force limit) plus a dozen
+// scattered grid loads; in lanes across nodes the same arithmetic runs in
+// SIMD registers and the loads of different nodes overlap.
+//
+// The lane code does, per node, the operations of interact_pass_a /
+// interact_pass_b_saved (kernels/multimaterial.hpp) for a deformable pair
+// with explicit integration, written with selects instead of early returns.
+// The compiler contracts multiply-adds differently in the two, so results
+// agree to round-off, not bitwise; tests/test_mm_pair_batch.cpp compares
+// them on every law, normal method, traction law and separation method.
+// The lane loops carry `GCC ivdep`, not `omp simd`: with -fopenmp, GCC 12
+// made the small std::array locals of an `omp simd` body per-lane arrays
+// and vectorised nothing.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+#include "kernels/grid_view.hpp"
+#include "kernels/mm_common.hpp"
+#include "kernels/mm_contact.hpp"
+#include "kernels/mm_interface.hpp"
+#include "kernels/mm_normals.hpp"
+
+namespace mmpm::mm_detail {
+
+// Up to kLanes two-material nodes of one pair (field_a < field_b): inputs
+// gathered from the grid, outputs for the caller to apply in list order.
+template <int D, class Real>
+struct PairBatch {
+  static constexpr int kLanes = 64;  // one chunk of the node list
+
+  int count = 0;
+  int field_a = -1, field_b = -1;
+  const PairParams<Real>* params = nullptr;
+  std::uint32_t node[kLanes];
+
+  // Inputs: side 0 = field_a, side 1 = field_b.
+  alignas(64) Real m[2][kLanes];
+  alignas(64) Real vol[2][kLanes];
+  alignas(64) Real p[2][D][kLanes];
+  alignas(64) Real mx[2][D][kLanes];
+  alignas(64) Real g[2][D][kLanes];
+  alignas(64) Real f[2][D][kLanes];
+  alignas(64) Real x[D][kLanes];  // node positions (radial normal)
+  // Pass B input / pass A output: the saved geometry and stick flags.
+  alignas(64) Real n[D][kLanes];
+  alignas(64) Real dn[kLanes];
+  alignas(64) unsigned char stick[kLanes];
+
+  // Outputs for field_a (field_b gets the negatives).
+  alignas(64) Real change[D][kLanes];
+  alignas(64) Real force[D][kLanes];
+  alignas(64) double energy[kLanes];
+  alignas(64) int limited[kLanes];
+};
+
+// What a batch reads besides m and p.
+struct BatchNeeds {
+  bool vol = true, geometry = true, gradient = false, position = false, force = false;
+};
+
+template <int D, class Real>
+void gather_batch(const GridView<D, Real>& grid, const BatchNeeds& needs, PairBatch<D, Real>& B) {
+  const std::size_t base[2] = {grid.at(B.field_a, 0), grid.at(B.field_b, 0)};
+  const int n = B.count;
+  for (int s = 0; s < 2; ++s) {
+    const std::size_t o = base[s];
+    for (int i = 0; i < n; ++i) B.m[s][i] = grid.m[o + B.node[i]];
+    if (needs.vol)
+      for (int i = 0; i < n; ++i) B.vol[s][i] = grid.vol[o + B.node[i]];
+    for (int d = 0; d < D; ++d) {
+      for (int i = 0; i < n; ++i) B.p[s][d][i] = grid.p[d][o + B.node[i]];
+      if (needs.geometry)
+        for (int i = 0; i < n; ++i) B.mx[s][d][i] = grid.mx[d][o + B.node[i]];
+      if (needs.gradient)
+        for (int i = 0; i < n; ++i) B.g[s][d][i] = grid.g[d][o + B.node[i]];
+      if (needs.force)
+        for (int i = 0; i < n; ++i) B.f[s][d][i] = grid.f[d][o + B.node[i]];
+    }
+  }
+  if (needs.position)
+    for (int i = 0; i < n; ++i) {
+      const std::array<Real, 3> x = grid.position(B.node[i]);
+      for (int d = 0; d < D; ++d) B.x[d][i] = x[d];
+    }
+}
+
+// normalized_or_zero without the early return.
+template <int D, class Real>
+inline VecD<D, Real> unit_or_zero(const VecD<D, Real>& u) {
+  const Real len = std::sqrt(dot<D, Real>(u, u));
+  const bool ok = (len > 0) & std::isfinite(len);
+  const Real inv = Real(1) / len;
+  VecD<D, Real> r;
+  for (int d = 0; d < D; ++d) r[d] = ok ? u[d] * inv : Real(0);
+  return r;
+}
+
+// directional_stick_change with selects.
+template <int D, class Real>
+inline VecD<D, Real> stick_change_lane(unsigned char stick, const VecD<D, Real>& dp,
+                                       const VecD<D, Real>& n) {
+  const bool normal = (stick & (kStickNormal | kStickBoth)) != 0;
+  const bool tangential = (stick & (kStickTangential | kStickBoth)) != 0;
+  const Real dn = dot<D, Real>(dp, n);
+  VecD<D, Real> r;
+  for (int d = 0; d < D; ++d) {
+    const Real along = n[d] * dn;
+    const Real across = dp[d] + -dn * n[d];  // add_scaled(dp, n, −dn)
+    r[d] = normal & tangential ? dp[d] : normal ? along : tangential ? across : Real(0);
+  }
+  return r;
+}
+
+// contact_momentum_change for a law fixed at compile time, times "in contact".
+template <Law L, int D, class Real>
+inline VecD<D, Real> contact_change_lane(bool contact, Real friction, const VecD<D, Real>& dp,
+                                         const VecD<D, Real>& n) {
+  const Real dn = dot<D, Real>(dp, n);
+  VecD<D, Real> r;
+  if constexpr (L == Law::stick) {
+    r = dp;
+  } else if constexpr (L == Law::frictionless) {
+    for (int d = 0; d < D; ++d) r[d] = n[d] * dn;
+  } else {  // Law::friction (P-16)
+    VecD<D, Real> dp_t;
+    for (int d = 0; d < D; ++d) dp_t[d] = dp[d] + -dn * n[d];
+    const Real dt_len = std::sqrt(dot<D, Real>(dp_t, dp_t));
+    const bool slide = dt_len > -friction * dn;
+    const Real cap_over_len = -friction * dn / dt_len;
+    for (int d = 0; d < D; ++d) {
+      const Real along = n[d] * dn;
+      r[d] = slide ? along + cap_over_len * dp_t[d] : dp[d];
+    }
+  }
+  for (int d = 0; d < D; ++d) r[d] = contact ? r[d] : Real(0);
+  return r;
+}
+
+// Lane i of a D × kLanes array (v = its first row). A reference-to-array
+// parameter here kept GCC 12 from vectorising the lane loops.
+template <int D, class Real>
+inline VecD<D, Real> lane(const Real* v, int i) {
+  VecD<D, Real> r;
+  for (int d = 0; d < D; ++d) r[d] = v[d * PairBatch<D, Real>::kLanes + i];
+  return r;
+}
+
+// Pass A on the lanes of B: the normal by method M, the pair's law L
+// (Law::interface: the imperfect interface with explicit integration).
+template <NormalMethod M, Law L, int D, class Real>
+void pass_a_lanes(PairBatch<D, Real>& B, Real sign, const std::array<Real, 3>& h, Real dt,
+                  Real thickness, bool use_force_difference) {
+  const PairParams<Real>& pp = *B.params;
+  const Real omega_min = pp.omega_min, friction = pp.friction;
+  const bool position_method = pp.separation == Separation::position;
+  const bool bilinear = pp.traction_law == TractionLaw::bilinear;
+  const bool force_limit = pp.force_limit;
+  const Real Dn = pp.Dn, Dn_compression = pp.Dn_compression, Dt_stiffness = pp.Dt;
+  const Real s_out = Real(kDomainGradientOutward);
+  const int count = B.count;
+#pragma GCC ivdep
+  for (int i = 0; i < count; ++i) {
+    const Real ma = B.m[0][i], mb = B.m[1][i], va = B.vol[0][i], vb = B.vol[1][i];
+    const VecD<D, Real> pa = lane<D, Real>(B.p[0][0], i), pb = lane<D, Real>(B.p[1][0], i);
+    // §5 normal a → b.
+    VecD<D, Real> n;
+    if constexpr (M == NormalMethod::avg) {
+      const VecD<D, Real> ga = lane<D, Real>(B.g[0][0], i), gb = lane<D, Real>(B.g[1][0], i);
+      VecD<D, Real> u;
+      for (int d = 0; d < D; ++d) u[d] = s_out * (va * ga[d] - vb * gb[d]);
+      n = unit_or_zero<D, Real>(u);
+    } else if constexpr (M == NormalMethod::specified) {
+      VecD<D, Real> u;
+      for (int d = 0; d < D; ++d) u[d] = sign * pp.normal_vector[d];
+      n = unit_or_zero<D, Real>(u);
+    } else if constexpr (M == NormalMethod::radial) {
+      VecD<D, Real> u;
+      for (int d = 0; d < D; ++d) u[d] = sign * (B.x[d][i] - pp.radial_center[d]);
+      n = unit_or_zero<D, Real>(u);
+    } else {  // mvg (and rigid, which is mvg without a rigid partner)
+      const VecD<D, Real> ga = lane<D, Real>(B.g[0][0], i), gb = lane<D, Real>(B.g[1][0], i);
+      const bool use_a = dot<D, Real>(ga, ga) >= dot<D, Real>(gb, gb);
+      VecD<D, Real> u;
+      for (int d = 0; d < D; ++d) u[d] = use_a ? ga[d] * s_out : gb[d] * -s_out;
+      n = unit_or_zero<D, Real>(u);
+    }
+    // Bitwise & | on the lane masks below: GCC 12 does not vectorise the
+    // selects of booleans that && and || become.
+    const bool screened = va + vb < omega_min;
+    const bool valid = !screened & (dot<D, Real>(n, n) != Real(0));
+
+    // (P-7, P-8), (P-11), (P-12), (P-15), (P-22), (P-14).
+    const VecD<D, Real> dp = momentum_change_to_center_of_mass<D, Real>(ma, pa, mb, pb, false);
+    const Real inv_ma = Real(1) / ma, inv_mb = Real(1) / mb;
+    VecD<D, Real> delta;
+    for (int d = 0; d < D; ++d) delta[d] = B.mx[1][d][i] * inv_mb - B.mx[0][d][i] * inv_ma;
+    const Real delta_n = dot<D, Real>(delta, n);
+    const VecD<D, Real> opening_t = add_scaled<D, Real>(delta, n, -delta_n);
+    const Real delta_t = std::sqrt(dot<D, Real>(opening_t, opening_t));
+    VecD<D, Real> t;
+    {
+      const Real inv_len = Real(1) / delta_t;
+      VecD<D, Real> perpendicular;
+      if constexpr (D == 2) {
+        perpendicular = {-n[1], n[0]};
+      } else {  // tangent_or_perpendicular's axis least aligned with n
+        const Real a0 = std::abs(n[0]), a1 = std::abs(n[1]), a2 = std::abs(n[2]);
+        const bool axis1 = a1 < a0;
+        const Real best01 = axis1 ? a1 : a0;
+        const bool axis2 = a2 < best01;
+        const Real n_axis = axis2 ? n[2] : axis1 ? n[1] : n[0];
+        VecD<D, Real> e;
+        e[0] = !axis2 && !axis1 ? Real(1) : Real(0);
+        e[1] = !axis2 && axis1 ? Real(1) : Real(0);
+        e[2] = axis2 ? Real(1) : Real(0);
+        perpendicular = unit_or_zero<D, Real>(add_scaled<D, Real>(e, n, -n_axis));
+      }
+      for (int d = 0; d < D; ++d) t[d] = delta_t > 0 ? opening_t[d] * inv_len : perpendicular[d];
+    }
+    const Real hp = h_perp<D, Real>(n, t, h);
+    const Real dn = position_method ? delta_n - Real(0.8) * hp : delta_n;
+    for (int d = 0; d < D; ++d) B.n[d][i] = valid ? n[d] : Real(0);
+    B.dn[i] = valid ? dn : Real(0);
+    const Real dp_n = dot<D, Real>(dp, n);
+
+    VecD<D, Real> change, force{};
+    [[maybe_unused]] double energy = 0;
+    [[maybe_unused]] unsigned char stick = 0;
+    [[maybe_unused]] int limited = 0;
+    if constexpr (L != Law::interface) {
+      // in_contact (P-9, P-12, P-14), with & on the masks.
+      change = contact_change_lane<L, D, Real>((dp_n < 0) & (dn < 0), friction, dp, n);
+    } else {
+      // §3.2 traction (linear or bilinear), (P-20) area, §4.4 force limit.
+      const Real Dn_now = bilinear & (dn < 0) ? Dn_compression : Dn;
+      Real Tn, kn, en, Tt, kt, et;
+      bool perfect_n, perfect_t;
+      linear_direction(Dn_now, dn, Tn, kn, en, perfect_n);
+      linear_direction(Dt_stiffness, delta_t, Tt, kt, et, perfect_t);
+      const Real area = contact_area<D, Real>(va, vb, hp, thickness);
+      const Real m_red = reduced_mass(ma, mb, false);
+      VecD<D, Real> df{};
+      if (use_force_difference)
+        df = force_difference<D, Real>(ma, lane<D, Real>(B.f[0][0], i), mb,
+                                       lane<D, Real>(B.f[1][0], i), false);
+      const Real fn = Tn * area, ft = Tt * area;
+      const bool over_n =
+          exceeds_force_limit(fn, force_limit_component(m_red, dt, dn, dp_n, dot<D, Real>(df, n)));
+      const bool over_t = exceeds_force_limit(
+          ft, force_limit_component(m_red, dt, delta_t, dot<D, Real>(dp, t), dot<D, Real>(df, t)));
+      const bool limit_n = !perfect_n & force_limit & over_n;
+      const bool limit_t = !perfect_t & force_limit & over_t;
+      const bool stick_n = perfect_n | limit_n, stick_t = perfect_t | limit_t;
+      stick = (unsigned char)((stick_n ? kStickNormal : 0) | (stick_t ? kStickTangential : 0) |
+                              (stick_n & stick_t ? kStickBoth : 0));
+      limited = int(limit_n) + int(limit_t);
+      change = stick_change_lane<D, Real>(stick, dp, n);
+      const Real on = stick_n ? Real(0) : fn, ot = stick_t ? Real(0) : ft;
+      for (int d = 0; d < D; ++d) force[d] = on * n[d] + ot * t[d];
+      energy = double(stick_n ? Real(0) : en * area) + double(stick_t ? Real(0) : et * area);
+    }
+    for (int d = 0; d < D; ++d) B.change[d][i] = valid ? change[d] : Real(0);
+    if constexpr (L == Law::interface) {
+      for (int d = 0; d < D; ++d) B.force[d][i] = valid ? force[d] : Real(0);
+      B.energy[i] = valid ? energy : 0.0;
+      B.stick[i] = valid ? stick : (unsigned char)0;
+      B.limited[i] = valid ? limited : 0;
+    }
+  }
+  if constexpr (L != Law::interface) {  // contact laws: no force, energy or flags
+    for (int i = 0; i < count; ++i) {
+      for (int d = 0; d < D; ++d) B.force[d][i] = Real(0);
+      B.energy[i] = 0;
+      B.stick[i] = 0;
+      B.limited[i] = 0;
+    }
+  }
+}
+
+// Pass B on the lanes of B from pass A's saved normal and separation (B.n,
+// B.dn) and stick flags (B.stick): interact_pass_b_saved lane by lane.
+template <Law L, int D, class Real>
+void pass_b_lanes(PairBatch<D, Real>& B) {
+  const Real friction = B.params->friction;
+  const int count = B.count;
+#pragma GCC ivdep
+  for (int i = 0; i < count; ++i) {
+    const VecD<D, Real> n = lane<D, Real>(B.n[0], i);
+    const VecD<D, Real> dp = momentum_change_to_center_of_mass<D, Real>(
+        B.m[0][i], lane<D, Real>(B.p[0][0], i), B.m[1][i], lane<D, Real>(B.p[1][0], i), false);
+    const bool has_normal = dot<D, Real>(n, n) != Real(0);
+    VecD<D, Real> change;
+    if constexpr (L == Law::interface) {
+      change = stick_change_lane<D, Real>(B.stick[i], dp, n);
+    } else {
+      const bool contact = (dot<D, Real>(dp, n) < 0) & (B.dn[i] < 0);  // in_contact
+      change = contact_change_lane<L, D, Real>(contact, friction, dp, n);
+    }
+    for (int d = 0; d < D; ++d) B.change[d][i] = has_normal ? change[d] : Real(0);
+  }
+}
+
+template <NormalMethod M, int D, class Real>
+void pass_a_lanes_of_law(PairBatch<D, Real>& B, Real sign, const std::array<Real, 3>& h, Real dt,
+                         Real thickness, bool use_force_difference) {
+  switch (B.params->law) {
+    case Law::stick:
+      return pass_a_lanes<M, Law::stick>(B, sign, h, dt, thickness, use_force_difference);
+    case Law::frictionless:
+      return pass_a_lanes<M, Law::frictionless>(B, sign, h, dt, thickness, use_force_difference);
+    case Law::friction:
+      return pass_a_lanes<M, Law::friction>(B, sign, h, dt, thickness, use_force_difference);
+    default:
+      return pass_a_lanes<M, Law::interface>(B, sign, h, dt, thickness, use_force_difference);
+  }
+}
+
+// Pass A on a gathered batch whose pair is batchable (batchable_pair).
+template <int D, class Real>
+void pass_a_batch(PairBatch<D, Real>& B, const std::array<Real, 3>& h, Real dt, Real thickness,
+                  bool use_force_difference) {
+  const Real sign = B.field_a == B.params->first_field ? Real(1) : Real(-1);
+  switch (B.params->normal_method) {
+    case NormalMethod::avg:
+      return pass_a_lanes_of_law<NormalMethod::avg>(B, sign, h, dt, thickness,
+                                                    use_force_difference);
+    case NormalMethod::specified:
+      return pass_a_lanes_of_law<NormalMethod::specified>(B, sign, h, dt, thickness,
+                                                          use_force_difference);
+    case NormalMethod::radial:
+      return pass_a_lanes_of_law<NormalMethod::radial>(B, sign, h, dt, thickness,
+                                                       use_force_difference);
+    default:  // mvg; rigid without a rigid partner is mvg (§5)
+      return pass_a_lanes_of_law<NormalMethod::mvg>(B, sign, h, dt, thickness,
+                                                    use_force_difference);
+  }
+}
+
+template <int D, class Real>
+void pass_b_batch(PairBatch<D, Real>& B) {
+  switch (B.params->law) {
+    case Law::stick:
+      return pass_b_lanes<Law::stick>(B);
+    case Law::frictionless:
+      return pass_b_lanes<Law::frictionless>(B);
+    case Law::friction:
+      return pass_b_lanes<Law::friction>(B);
+    default:
+      return pass_b_lanes<Law::interface>(B);
+  }
+}
+
+// The pairs the batch handles: explicit integration in pass A (the exact
+// spring's sines stay on the per-node path); any law in pass B from saved
+// geometry. Both fields deformable is checked by the caller.
+template <class Real>
+inline bool batchable_pair(const PairParams<Real>& pp, bool pass_a) {
+  return !pass_a || pp.integration == Integration::explicit_;
+}
+
+}  // namespace mmpm::mm_detail

@@ -1,0 +1,247 @@
+// Two-material nodes in batches (kernels/mm_pair_batch.hpp) against the
+// per-node path of the multimaterial pass (kernels/multimaterial.hpp): the
+// same grids through pass A and MUSL's two passes B, with
+// MMConfig::batch_pairs on and off. Every law, normal method, traction law,
+// separation method, force limit on/off, Δf on/off, perfect and zero
+// stiffnesses, volume screening; 2D and 3D, double and float; and a grid of
+// four fields (one rigid, one pair with the exact integration) where batched
+// and per-node nodes mix in one chunk.
+//
+// Expected: the same stick flags and node counts, momenta and energies
+// within round-off (relative to each array's largest value: 1e-13 in
+// double, 1e-5 in float), interface forces within the round-off of the
+// separations times the stiffness (force_tolerance). The lane code writes the same
+// operations in the same order, but the compiler contracts a*b + c into
+// FMAs differently in the two codes (-ffp-contract=fast), so the last bits
+// differ; a missed case or a wrong sign differs by O(1).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "kernels/multimaterial.hpp"
+#include "tests/mm_test_grid.hpp"
+
+namespace {
+
+using mmpm::Integration;
+using mmpm::Law;
+using mmpm::MMStats;
+using mmpm::NormalMethod;
+using mmpm::PairParams;
+using mmpm::SavedGeometry;
+using mmpm::Separation;
+using mmpm::TractionLaw;
+using mmpm::test::fill_random;
+using mmpm::test::TestGrid;
+using mmpm::test::TestSetup;
+
+template <class Real>
+constexpr double kTolerance = std::is_same_v<Real, float> ? 1e-5 : 1e-13;
+
+struct Outcome {
+  MMStats stats;
+  std::vector<unsigned char> flags;
+  long limited_total = 0;
+};
+
+template <int D, class Real>
+Outcome run(TestGrid<D, Real>& grid, TestSetup<D, Real>& setup, bool batch) {
+  setup.cfg.batch_pairs = batch;
+  const auto& cfg = setup.config();
+  EXPECT_EQ(mmpm::validate_multimaterial(grid.view, cfg), nullptr);
+  std::vector<std::uint32_t> list;
+  mmpm::find_multimaterial_nodes(grid.view, cfg.mass_threshold, list);
+  Outcome out;
+  out.stats.reset(setup.F);
+  std::vector<SavedGeometry<D, Real>> geometry;
+  mmpm::multimaterial_pass_a(grid.view, list, cfg, out.stats, out.flags, {}, &geometry);
+  out.limited_total = out.stats.force_limited;
+  for (int pass = 0; pass < 2; ++pass) {  // MUSL: pass B after each transfer
+    for (std::size_t i = 0; i < grid.p[0].size(); ++i)
+      for (int d = 0; d < D; ++d) grid.p[d][i] += Real(0.02) * grid.f[d][i];
+    mmpm::multimaterial_pass_b(grid.view, list, cfg, out.flags, out.stats, {}, &geometry);
+  }
+  return out;
+}
+
+// Largest |a − b| over an array, relative to the array's largest |b|.
+template <class Real>
+double relative_difference(const std::vector<Real>& a, const std::vector<Real>& b) {
+  double worst = 0, scale = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const double diff = std::abs(double(a[i]) - double(b[i]));
+    worst = diff > worst || diff != diff ? diff : worst;
+    scale = std::max(scale, std::abs(double(b[i])));
+  }
+  return scale > 0 ? worst / scale : worst;
+}
+
+template <class Real>
+double largest_difference(const std::vector<Real>& a, const std::vector<Real>& b) {
+  double worst = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const double diff = std::abs(double(a[i]) - double(b[i]));
+    worst = diff > worst || diff != diff ? diff : worst;
+  }
+  return worst;
+}
+
+// The interface force is D δ A with δ = mx_b/m_b − mx_a/m_a: its round-off
+// is that of δ (|δ| ≤ 0.1 in fill_random's data, ε|δ| per operation) times
+// the stiffness and the area (A ≤ 2 here), whatever the force itself. Where
+// δ is nearly along n, δ_t = |δ − δ_n n| is all cancellation: the two codes'
+// tangential forces then differ by D_t ε |δ| A while the force is small.
+template <class Real>
+double force_tolerance(double largest_finite_stiffness) {
+  return 64 * double(std::numeric_limits<Real>::epsilon()) * largest_finite_stiffness * 0.1 * 2;
+}
+
+template <int D, class Real>
+void expect_same(const std::string& what, const TestGrid<D, Real>& a, const Outcome& oa,
+                 const TestGrid<D, Real>& b, const Outcome& ob, double force_tol) {
+  SCOPED_TRACE(what);
+  const double tol = kTolerance<Real>;
+  for (int d = 0; d < D; ++d) {
+    EXPECT_LE(relative_difference(a.p[d], b.p[d]), tol) << "momentum " << d;
+    EXPECT_LE(largest_difference(a.fi[d], b.fi[d]), force_tol) << "interface force " << d;
+  }
+  EXPECT_EQ(oa.flags, ob.flags);
+  EXPECT_NEAR(oa.stats.interface_energy, ob.stats.interface_energy,
+              tol * std::abs(ob.stats.interface_energy));
+  EXPECT_EQ(oa.stats.nodes_2, ob.stats.nodes_2);
+  EXPECT_EQ(oa.stats.nodes_3plus, ob.stats.nodes_3plus);
+  EXPECT_EQ(oa.stats.force_limited, ob.stats.force_limited);
+  for (std::size_t j = 0; j < oa.stats.rigid_reaction.size(); ++j)
+    for (int d = 0; d < 3; ++d)
+      EXPECT_NEAR(oa.stats.rigid_reaction[j][d], ob.stats.rigid_reaction[j][d],
+                  tol * (1 + std::abs(ob.stats.rigid_reaction[j][d])));
+}
+
+std::array<int, 3> dims_of(int D) {
+  return D == 2 ? std::array<int, 3>{24, 20, 1} : std::array<int, 3>{8, 7, 6};
+}
+
+// Two fields, one pair: every combination of the pair's options.
+template <int D, class Real>
+void check_two_fields() {
+  constexpr Real kInf = std::numeric_limits<Real>::infinity();
+  const std::array<std::array<Real, 2>, 4> stiffness{
+      {{Real(5e3), Real(2e3)}, {Real(1e8), Real(3e7)}, {kInf, Real(5e2)}, {Real(0), kInf}}};
+  long cases = 0, limited = 0, screened_cases = 0;
+  double energy = 0;
+  for (Law law : {Law::stick, Law::frictionless, Law::friction, Law::interface})
+    for (NormalMethod normal : {NormalMethod::mvg, NormalMethod::avg, NormalMethod::specified,
+                                NormalMethod::radial, NormalMethod::rigid})
+      for (int variant = 0; variant < (law == Law::interface ? 32 : 4); ++variant) {
+        PairParams<Real> pp;
+        pp.law = law;
+        pp.friction = Real(0.3);
+        pp.normal_method = normal;
+        pp.normal_vector = {Real(0.6), Real(-0.8), Real(0)};
+        pp.radial_center = {Real(3), Real(4), Real(2)};
+        pp.separation = variant & 1 ? Separation::position : Separation::displacement;
+        pp.omega_min = variant & 2 ? Real(0.4) : Real(0);  // screens some nodes
+        pp.force_limit = (variant & 4) == 0;
+        pp.traction_law = variant & 8 ? TractionLaw::bilinear : TractionLaw::linear;
+        pp.Dn_compression = Real(7e3);
+        const auto& k = stiffness[std::size_t((variant >> 3) % 4)];
+        pp.Dn = k[0];
+        pp.Dt = k[1];
+        screened_cases += (variant & 2) != 0;
+        for (bool with_df : {false, true}) {
+          TestGrid<D, Real> batched(dims_of(D), 2), per_node(dims_of(D), 2);
+          const unsigned seed = unsigned(100 + cases);
+          fill_random(batched, seed);
+          fill_random(per_node, seed);
+          TestSetup<D, Real> s1(2, Real(1e-3)), s2(2, Real(1e-3));
+          // Connect (1, 0): specified and radial normals then point away
+          // from field 1, so the batch's sign is −1 half of the time.
+          const int first = variant & 16 ? 1 : 0;
+          s1.connect(first, 1 - first, pp);
+          s2.connect(first, 1 - first, pp);
+          s1.cfg.use_force_difference = s2.cfg.use_force_difference = with_df;
+          const Outcome o1 = run(batched, s1, true);
+          const Outcome o2 = run(per_node, s2, false);
+          double stiffest = double(pp.Dn_compression);
+          for (Real x : k) stiffest = std::isinf(x) ? stiffest : std::max(stiffest, double(x));
+          expect_same("law " + std::to_string(int(law)) + " normal " + std::to_string(int(normal)) +
+                          " variant " + std::to_string(variant) + " df " + std::to_string(with_df),
+                      batched, o1, per_node, o2, force_tolerance<Real>(stiffest));
+          ++cases;
+          limited += o2.limited_total;
+          energy += o2.stats.interface_energy;
+          if (::testing::Test::HasFailure()) return;  // one failing case is enough to read
+        }
+      }
+  // The cases exercised what they are meant to.
+  EXPECT_GT(limited, 0) << "no direction hit the force limit";
+  EXPECT_GT(energy, 0.0);
+  EXPECT_GT(screened_cases, 0);
+}
+
+TEST(MultimaterialPairBatch, TwoFieldsEveryOptionMatchesPerNode2D) {
+  check_two_fields<2, double>();
+}
+TEST(MultimaterialPairBatch, TwoFieldsEveryOptionMatchesPerNode3D) {
+  check_two_fields<3, double>();
+}
+TEST(MultimaterialPairBatch, TwoFieldsEveryOptionMatchesPerNode3DFloat) {
+  check_two_fields<3, float>();
+}
+TEST(MultimaterialPairBatch, TwoFieldsEveryOptionMatchesPerNode2DFloat) {
+  check_two_fields<2, float>();
+}
+
+// Four fields, field 3 rigid, six pairs with different laws and normals, one
+// with the exact integration: chunks mix batched nodes (the first pair met),
+// nodes of other pairs, nodes with three or four fields and rigid partners.
+template <int D, class Real>
+void check_mixed_fields() {
+  auto setup = [] {
+    TestSetup<D, Real> s(4, Real(1e-3));
+    s.rigid[3] = 1;
+    PairParams<Real> pp;
+    pp.Dn = Real(5e3);
+    pp.Dt = Real(2e3);
+    pp.friction = Real(0.3);
+    const std::array<Law, 6> laws{Law::interface, Law::friction,  Law::stick,
+                                  Law::interface, Law::interface, Law::frictionless};
+    const std::array<NormalMethod, 6> normals{NormalMethod::mvg,    NormalMethod::avg,
+                                              NormalMethod::radial, NormalMethod::specified,
+                                              NormalMethod::rigid,  NormalMethod::mvg};
+    int k = 0;
+    for (int a = 0; a < 4; ++a)
+      for (int b = a + 1; b < 4; ++b, ++k) {
+        pp.law = laws[std::size_t(k)];
+        pp.normal_method = normals[std::size_t(k)];
+        pp.integration = k == 3 ? Integration::exact : Integration::explicit_;
+        s.connect(a, b, pp);
+      }
+    s.cfg.use_force_difference = true;
+    return s;
+  };
+  TestGrid<D, Real> batched(dims_of(D), 4), per_node(dims_of(D), 4);
+  fill_random(batched, 7);
+  fill_random(per_node, 7);
+  auto s1 = setup(), s2 = setup();
+  const Outcome o1 = run(batched, s1, true);
+  const Outcome o2 = run(per_node, s2, false);
+  EXPECT_GT(o2.stats.nodes_2, 50);
+  EXPECT_GT(o2.stats.nodes_3plus, 50);
+  expect_same("four fields", batched, o1, per_node, o2, force_tolerance<Real>(5e3));
+}
+
+TEST(MultimaterialPairBatch, MixedChunksMatchPerNode2D) {
+  check_mixed_fields<2, double>();
+}
+TEST(MultimaterialPairBatch, MixedChunksMatchPerNode3DFloat) {
+  check_mixed_fields<3, float>();
+}
+
+}  // namespace
