@@ -112,4 +112,30 @@ void fill_random(TestGrid<D, Real>& grid, unsigned seed) {
     }
 }
 
+// Four fields, field 3 rigid, the six pairs (0,1) (0,2) (0,3) (1,2) (1,3)
+// (2,3) with the given laws and normal methods, pair `exact_pair` with the
+// exact integration, Δf_i on; Dn 5e3, Dt 2e3, μ 0.3, radial centre (3, 4, 5).
+template <int D, class Real>
+TestSetup<D, Real> four_field_setup(const std::array<mmpm::Law, 6>& laws,
+                                    const std::array<mmpm::NormalMethod, 6>& normals,
+                                    int exact_pair) {
+  TestSetup<D, Real> setup(4, Real(1e-3));
+  setup.rigid[3] = 1;
+  mmpm::PairParams<Real> pp;
+  pp.Dn = Real(5e3);
+  pp.Dt = Real(2e3);
+  pp.friction = Real(0.3);
+  pp.radial_center = {3, 4, 5};
+  int k = 0;
+  for (int a = 0; a < 4; ++a)
+    for (int b = a + 1; b < 4; ++b, ++k) {
+      pp.law = laws[std::size_t(k)];
+      pp.normal_method = normals[std::size_t(k)];
+      pp.integration = k == exact_pair ? mmpm::Integration::exact : mmpm::Integration::explicit_;
+      setup.connect(a, b, pp);
+    }
+  setup.cfg.use_force_difference = true;
+  return setup;
+}
+
 }  // namespace mmpm::test

@@ -204,27 +204,12 @@ TEST(MultimaterialPairBatch, TwoFieldsEveryOptionMatchesPerNode2DFloat) {
 template <int D, class Real>
 void check_mixed_fields() {
   auto setup = [] {
-    TestSetup<D, Real> s(4, Real(1e-3));
-    s.rigid[3] = 1;
-    PairParams<Real> pp;
-    pp.Dn = Real(5e3);
-    pp.Dt = Real(2e3);
-    pp.friction = Real(0.3);
-    const std::array<Law, 6> laws{Law::interface, Law::friction,  Law::stick,
-                                  Law::interface, Law::interface, Law::frictionless};
-    const std::array<NormalMethod, 6> normals{NormalMethod::mvg,    NormalMethod::avg,
-                                              NormalMethod::radial, NormalMethod::specified,
-                                              NormalMethod::rigid,  NormalMethod::mvg};
-    int k = 0;
-    for (int a = 0; a < 4; ++a)
-      for (int b = a + 1; b < 4; ++b, ++k) {
-        pp.law = laws[std::size_t(k)];
-        pp.normal_method = normals[std::size_t(k)];
-        pp.integration = k == 3 ? Integration::exact : Integration::explicit_;
-        s.connect(a, b, pp);
-      }
-    s.cfg.use_force_difference = true;
-    return s;
+    return mmpm::test::four_field_setup<D, Real>(
+        {Law::interface, Law::friction, Law::stick, Law::interface, Law::interface,
+         Law::frictionless},
+        {NormalMethod::mvg, NormalMethod::avg, NormalMethod::radial, NormalMethod::specified,
+         NormalMethod::rigid, NormalMethod::mvg},
+        3);
   };
   TestGrid<D, Real> batched(dims_of(D), 4), per_node(dims_of(D), 4);
   fill_random(batched, 7);

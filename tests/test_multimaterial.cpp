@@ -1040,28 +1040,11 @@ void run_both_passes(TestGrid<D, Real>& grid, TestSetup<D, Real>& setup, MMStats
 // Four fields, field 3 rigid, every pair with another law and normal method.
 template <int D, class Real>
 TestSetup<D, Real> all_pairs_setup() {
-  TestSetup<D, Real> setup(4, Real(1e-3));
-  setup.rigid[3] = 1;
-  PairParams<Real> pp;
-  pp.Dn = Real(5e3);
-  pp.Dt = Real(2e3);
-  pp.friction = Real(0.3);
-  const std::array<Law, 6> laws{Law::stick,     Law::frictionless, Law::friction,
-                                Law::interface, Law::interface,    Law::friction};
-  const std::array<NormalMethod, 6> normals{NormalMethod::mvg,    NormalMethod::avg,
-                                            NormalMethod::radial, NormalMethod::mvg,
-                                            NormalMethod::rigid,  NormalMethod::specified};
-  int k = 0;
-  for (int a = 0; a < 4; ++a)
-    for (int b = a + 1; b < 4; ++b, ++k) {
-      pp.law = laws[std::size_t(k)];
-      pp.normal_method = normals[std::size_t(k)];
-      pp.integration = k == 4 ? Integration::exact : Integration::explicit_;
-      pp.radial_center = {3, 4, 5};
-      setup.connect(a, b, pp);
-    }
-  setup.cfg.use_force_difference = true;
-  return setup;
+  return mmpm::test::four_field_setup<D, Real>(
+      {Law::stick, Law::frictionless, Law::friction, Law::interface, Law::interface, Law::friction},
+      {NormalMethod::mvg, NormalMethod::avg, NormalMethod::radial, NormalMethod::mvg,
+       NormalMethod::rigid, NormalMethod::specified},
+      4);
 }
 
 // 1 thread vs 2 threads with the node split `two_split` (empty: even). A
