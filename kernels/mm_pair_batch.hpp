@@ -3,8 +3,10 @@
 // batches"). Most multimaterial nodes hold exactly two deformable materials
 // joined by one interaction. Node by node, each costs a chain of square
 // roots and divisions (normal, tangent, h⊥, area, force limit) plus a dozen
-// scattered grid loads; in lanes across nodes the same arithmetic runs in
-// SIMD registers and the loads of different nodes overlap.
+// scattered grid loads; in lanes across nodes the work of different nodes
+// overlaps (independent chains, array-by-array gathers), and where GCC
+// vectorises a lane loop (pass B's, for most laws; not pass A's, see
+// docs/multimaterial.md) it runs in SIMD registers.
 //
 // The lane code does, per node, the operations of interact_pass_a /
 // interact_pass_b_saved (kernels/multimaterial.hpp) for a deformable pair
@@ -190,8 +192,8 @@ void pass_a_lanes(PairBatch<D, Real>& B, Real sign, const std::array<Real, 3>& h
       for (int d = 0; d < D; ++d) u[d] = use_a ? ga[d] * s_out : gb[d] * -s_out;
       n = unit_or_zero<D, Real>(u);
     }
-    // Bitwise & | on the lane masks below: GCC 12 does not vectorise the
-    // selects of booleans that && and || become.
+    // & and | rather than && and || on lane conditions: short-circuits are
+    // branches, which keep a loop from being if-converted and vectorised.
     const bool screened = va + vb < omega_min;
     const bool valid = !screened & (dot<D, Real>(n, n) != Real(0));
 
