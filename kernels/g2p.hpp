@@ -189,11 +189,13 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
   std::conditional_t<kDefer, GroupedScatter<D, Shape, Real, kMomentumOnly, false, kDeferUG>,
                      NoDeferred>
       deferred(G);
+  auto momentum_source = [&](std::size_t p) __attribute__((always_inline)) {
+    return scatter_source<D, Real, kMomentumOnly, false>(P, P2GOptions{}, Real(1), p);
+  };
   auto scatter_momentum = [&](const Weights& w, std::size_t p, std::size_t fo)
       __attribute__((always_inline)) {
     if constexpr (kDefer) return;  // after the batch
-    ScatterSource<D, Real> s;
-    for (int d = 0; d < D; ++d) s.mv[d] = P.m[p] * P.v[d][p];
+    const ScatterSource<D, Real> s = momentum_source(p);
     if constexpr (Windowed) {
       block.at(w.base + fo, G, off);
       block.accumulate(w, s);
@@ -214,7 +216,7 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
     }
     const Weights& w = *weights;
     const int field = MultiField ? int(P.field[p]) : 0;
-    const std::size_t fo = MultiField ? std::size_t(field) * G.nodes : 0;
+    const std::size_t fo = field_offset<MultiField>(P, G, p);
     if constexpr ((What & kUpdateMotion) != 0) {
       if (MultiField && q.rigid && q.rigid[field]) {  // prescribed motion (§7)
         for (int d = 0; d < D; ++d) {
@@ -267,8 +269,8 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
       std::size_t count = 0;
       for (; count < n && ok[count]; ++count) {
         const std::size_t p = first + count;
-        base[count] = w[count].base + (MultiField ? std::size_t(P.field[p]) * G.nodes : 0);
-        for (int d = 0; d < D; ++d) s[count].mv[d] = P.m[p] * P.v[d][p];
+        base[count] = w[count].base + field_offset<MultiField>(P, G, p);
+        s[count] = momentum_source(p);
       }
       deferred.add(w, base, s, count, count == n && first + n < end);
     }

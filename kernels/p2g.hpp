@@ -26,7 +26,7 @@ std::size_t p2g_range_pointwise(const ParticleView<D, Real>& P, const GridView<D
   Stencil<D, Shape, Real> st{};
   for (std::size_t p = begin; p < end; ++p) {
     if (!st.build(P, G, inv_h, p)) return p;
-    const std::size_t fo = MultiField ? std::size_t(P.field[p]) * G.nodes : 0;
+    const std::size_t fo = field_offset<MultiField>(P, G, p);
     const std::size_t b = st.base + fo;
     const Real mp = P.m[p];
     Real mv[D], vs[NS], fe[D], mw[D];
@@ -78,28 +78,6 @@ std::size_t p2g_range_pointwise(const ParticleView<D, Real>& P, const GridView<D
   return end;
 }
 
-// The per-particle factors of particle p (what WindowBlock::accumulate scatters).
-template <int D, class Real, unsigned What, bool Traction>
-[[gnu::always_inline]] inline ScatterSource<D, Real> scatter_source(const ParticleView<D, Real>& P,
-                                                                    const P2GOptions& opt,
-                                                                    Real inv_t, std::size_t p) {
-  constexpr int NS = kStressComponents<D>;
-  ScatterSource<D, Real> q;
-  q.m = P.m[p];
-  for (int d = 0; d < D; ++d) q.mv[d] = q.m * P.v[d][p];
-  if constexpr ((What & kForce) != 0) {
-    for (int c = 0; c < NS; ++c) q.vs[c] = P.V[p] * P.s[c][p];
-    if constexpr (Traction)
-      for (int d = 0; d < D; ++d) q.fe[d] = P.fext[d][p];
-  }
-  if constexpr ((What & kMultimaterial) != 0) {
-    q.area = P.V[p] * (D == 2 ? inv_t : Real(1));
-    for (int d = 0; d < D; ++d)
-      q.mw[d] = q.m * (opt.position_separation ? P.x[d][p] : P.x[d][p] - P.x0[d][p]);
-  }
-  return q;
-}
-
 // The windowed scatter for blocks that do not fit in the registers
 // (GroupedScatter, kernels/window_block.hpp): each run of particles with the
 // same window is scattered once per group of UG units, so each group's sums
@@ -124,7 +102,7 @@ std::size_t p2g_range_grouped(const ParticleView<D, Real>& particles, const Grid
     std::size_t ok = 0;
     while (ok < n && builder.build(P, first + ok, w[ok])) ++ok;
     for (std::size_t i = 0; i < ok; ++i) {
-      base[i] = w[i].base + (MultiField ? std::size_t(P.field[first + i]) * G.nodes : 0);
+      base[i] = w[i].base + field_offset<MultiField>(P, G, first + i);
       q[i] = scatter_source<D, Real, What, Traction>(P, opt, inv_t, first + i);
     }
     scatter.add(w, base, q, ok, ok == n && first + n < end);
@@ -155,7 +133,7 @@ std::size_t p2g_range_one_block(const ParticleView<D, Real>& particles,
   };
   auto scatter = [&](std::size_t p, const Win* win) __attribute__((always_inline)) {
     if (!win) return false;
-    block.at(win->base + (MultiField ? std::size_t(P.field[p]) * G.nodes : 0), G, off);
+    block.at(win->base + field_offset<MultiField>(P, G, p), G, off);
     const ScatterSource<D, Real> q = scatter_source<D, Real, What, Traction>(P, opt, inv_t, p);
     block.accumulate(*win, q);
     return true;

@@ -38,6 +38,37 @@ struct ScatterSource {
   Real mw[D] = {};   // mass times displacement (or position)
 };
 
+// The per-particle factors of particle p (what WindowBlock::accumulate
+// scatters), for P2G and MUSL's momentum scatter in G2P. With What =
+// kMomentumOnly only m and mv are set (opt and inv_t are not read).
+template <int D, class Real, unsigned What, bool Traction>
+[[gnu::always_inline]] inline ScatterSource<D, Real> scatter_source(const ParticleView<D, Real>& P,
+                                                                    const P2GOptions& opt,
+                                                                    Real inv_t, std::size_t p) {
+  constexpr int NS = kStressComponents<D>;
+  ScatterSource<D, Real> q;
+  q.m = P.m[p];
+  for (int d = 0; d < D; ++d) q.mv[d] = q.m * P.v[d][p];
+  if constexpr ((What & kForce) != 0) {
+    for (int c = 0; c < NS; ++c) q.vs[c] = P.V[p] * P.s[c][p];
+    if constexpr (Traction)
+      for (int d = 0; d < D; ++d) q.fe[d] = P.fext[d][p];
+  }
+  if constexpr ((What & kMultimaterial) != 0) {
+    q.area = P.V[p] * (D == 2 ? inv_t : Real(1));
+    for (int d = 0; d < D; ++d)
+      q.mw[d] = q.m * (opt.position_separation ? P.x[d][p] : P.x[d][p] - P.x0[d][p]);
+  }
+  return q;
+}
+
+// Offset of particle p's field in the field-major grid arrays (0 with one field).
+template <bool MultiField, int D, class Real>
+[[gnu::always_inline]] inline std::size_t field_offset(const ParticleView<D, Real>& P,
+                                                       const GridView<D, Real>& G, std::size_t p) {
+  return MultiField ? std::size_t(P.field[p]) * G.nodes : 0;
+}
+
 // Sums for UG units of the window (all of them by default); the member
 // templates take the first unit U0 of the group (GroupedScatter below splits
 // the window into groups when one block would not fit in the registers).
