@@ -5,6 +5,8 @@
 // Volumes follow det(I + dt L) (small strain) or J V0 (finite strain).
 #pragma once
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -88,6 +90,131 @@ struct IsotropicPoint {
       P.s[4][p] += Real(0.5) * mu2 * dt * (P.L[2][p] + P.L[6][p]);  // xz
       P.s[5][p] += Real(0.5) * mu2 * dt * (P.L[1][p] + P.L[3][p]);  // xy
       P.V[p] *= volume_ratio(P, p, dt);
+    }
+  }
+  // Particles [first, last): the same arithmetic as operator(), as a loop
+  // the compiler vectorises. Why: called per particle, the update stayed a
+  // scalar call (GCC did not inline it, and the view's arrays may alias for
+  // all it knows); this loop reads the arrays through restrict pointers
+  // with the plane-stress branch hoisted (2D linear step, 1 thread:
+  // docs/performance.md "Constitutive pass").
+  void range(const ParticleView<D, Real>& P, std::size_t first, std::size_t last) const {
+    Real* __restrict V = P.V;
+    if constexpr (D == 2) {
+      const Real* __restrict L0 = P.L[0];
+      const Real* __restrict L1 = P.L[1];
+      const Real* __restrict L2 = P.L[2];
+      const Real* __restrict L3 = P.L[3];
+      Real* __restrict s0 = P.s[0];
+      Real* __restrict s1 = P.s[1];
+      Real* __restrict s2 = P.s[2];
+      Real* __restrict s3 = P.s[3];
+      if (pstress) {
+        const Real zz = nu / (Real(1) - nu);
+#pragma GCC ivdep
+        for (std::size_t p = first; p < last; ++p) {
+          const Real exx = dt * L0[p], eyy = dt * L3[p];
+          const Real exy = Real(0.5) * dt * (L1[p] + L2[p]);
+          const Real a = Real(1) + exx, b = dt * L1[p], c = dt * L2[p], d = Real(1) + eyy;
+          s0[p] += Ep * (exx + nu * eyy);
+          s1[p] += Ep * (eyy + nu * exx);
+          s2[p] += mu2 * exy;
+          V[p] *= (a * d - b * c) * (Real(1) - zz * (exx + eyy));
+        }
+      } else {
+#pragma GCC ivdep
+        for (std::size_t p = first; p < last; ++p) {
+          const Real exx = dt * L0[p], eyy = dt * L3[p];
+          const Real exy = Real(0.5) * dt * (L1[p] + L2[p]);
+          const Real a = Real(1) + exx, b = dt * L1[p], c = dt * L2[p], d = Real(1) + eyy;
+          const Real tr = lam * (exx + eyy);
+          s0[p] += tr + mu2 * exx;
+          s1[p] += tr + mu2 * eyy;
+          s2[p] += mu2 * exy;
+          s3[p] += tr;
+          V[p] *= a * d - b * c;
+        }
+      }
+    } else {
+      const Real* __restrict L[9];
+      Real* __restrict s[6];
+      for (int i = 0; i < 9; ++i) L[i] = P.L[i];
+      for (int i = 0; i < 6; ++i) s[i] = P.s[i];
+#pragma GCC ivdep
+      for (std::size_t p = first; p < last; ++p) {
+        Real A[9];
+        for (int i = 0; i < 9; ++i) A[i] = dt * L[i][p] + ((i % 4) == 0 ? Real(1) : Real(0));
+        const Real e0 = dt * L[0][p], e1 = dt * L[4][p], e2 = dt * L[8][p];
+        const Real tr = lam * (e0 + e1 + e2);
+        s[0][p] += tr + mu2 * e0;
+        s[1][p] += tr + mu2 * e1;
+        s[2][p] += tr + mu2 * e2;
+        s[3][p] += Real(0.5) * mu2 * dt * (L[5][p] + L[7][p]);  // yz
+        s[4][p] += Real(0.5) * mu2 * dt * (L[2][p] + L[6][p]);  // xz
+        s[5][p] += Real(0.5) * mu2 * dt * (L[1][p] + L[3][p]);  // xy
+        V[p] *= A[0] * (A[4] * A[8] - A[5] * A[7]) - A[1] * (A[3] * A[8] - A[5] * A[6]) +
+                A[2] * (A[3] * A[7] - A[4] * A[6]);
+      }
+    }
+  }
+};
+
+// The isotropic update of several isotropic materials in one contiguous
+// loop: each particle's constants are looked up by its material byte, so
+// no per-material particle lists are needed and the loop vectorises (the
+// lists made it a gather loop of per-particle calls). Same arithmetic as
+// IsotropicPoint. Plane strain only (plane stress keeps the lists).
+template <int D, class Real>
+struct IsotropicByMaterial {
+  Real dt = 0;
+  std::array<Real, 256> lam{}, mu2{};  // by material index (P.mat)
+
+  void range(const ParticleView<D, Real>& P, std::size_t first, std::size_t last) const {
+    const std::uint8_t* __restrict mat = P.mat;
+    Real* __restrict V = P.V;
+    if constexpr (D == 2) {
+      const Real* __restrict L0 = P.L[0];
+      const Real* __restrict L1 = P.L[1];
+      const Real* __restrict L2 = P.L[2];
+      const Real* __restrict L3 = P.L[3];
+      Real* __restrict s0 = P.s[0];
+      Real* __restrict s1 = P.s[1];
+      Real* __restrict s2 = P.s[2];
+      Real* __restrict s3 = P.s[3];
+#pragma GCC ivdep
+      for (std::size_t p = first; p < last; ++p) {
+        const Real l = lam[mat[p]], m2 = mu2[mat[p]];
+        const Real exx = dt * L0[p], eyy = dt * L3[p];
+        const Real exy = Real(0.5) * dt * (L1[p] + L2[p]);
+        const Real a = Real(1) + exx, b = dt * L1[p], c = dt * L2[p], d = Real(1) + eyy;
+        const Real tr = l * (exx + eyy);
+        s0[p] += tr + m2 * exx;
+        s1[p] += tr + m2 * eyy;
+        s2[p] += m2 * exy;
+        s3[p] += tr;
+        V[p] *= a * d - b * c;
+      }
+    } else {
+      const Real* __restrict L[9];
+      Real* __restrict s[6];
+      for (int i = 0; i < 9; ++i) L[i] = P.L[i];
+      for (int i = 0; i < 6; ++i) s[i] = P.s[i];
+#pragma GCC ivdep
+      for (std::size_t p = first; p < last; ++p) {
+        const Real l = lam[mat[p]], m2 = mu2[mat[p]];
+        Real A[9];
+        for (int i = 0; i < 9; ++i) A[i] = dt * L[i][p] + ((i % 4) == 0 ? Real(1) : Real(0));
+        const Real e0 = dt * L[0][p], e1 = dt * L[4][p], e2 = dt * L[8][p];
+        const Real tr = l * (e0 + e1 + e2);
+        s[0][p] += tr + m2 * e0;
+        s[1][p] += tr + m2 * e1;
+        s[2][p] += tr + m2 * e2;
+        s[3][p] += Real(0.5) * m2 * dt * (L[5][p] + L[7][p]);  // yz
+        s[4][p] += Real(0.5) * m2 * dt * (L[2][p] + L[6][p]);  // xz
+        s[5][p] += Real(0.5) * m2 * dt * (L[1][p] + L[3][p]);  // xy
+        V[p] *= A[0] * (A[4] * A[8] - A[5] * A[7]) - A[1] * (A[3] * A[8] - A[5] * A[6]) +
+                A[2] * (A[3] * A[7] - A[4] * A[6]);
+      }
     }
   }
 };
@@ -190,6 +317,8 @@ inline void update_particles(const ParticleView<D, Real>& P, const std::uint32_t
                              std::size_t first, std::size_t last, const Update& f) {
   if (idx) {
     for (std::size_t k = first; k < last; ++k) f(P, std::size_t(idx[k]));
+  } else if constexpr (requires { f.range(P, first, last); }) {
+    f.range(P, first, last);
   } else {
     for (std::size_t k = first; k < last; ++k) f(P, k);
   }
@@ -200,6 +329,29 @@ inline void update_particles(const ParticleView<D, Real>& P, const std::uint32_t
 template <int D, class Real>
 inline bool particle_sound(const ParticleView<D, Real>& P, std::size_t p) {
   return P.V[p] > Real(0) && std::isfinite(P.V[p]) && std::isfinite(P.s[0][p]);
+}
+
+// The first particle of [lo, hi) that is not sound, or SIZE_MAX. The test
+// runs as a vectorised flag over chunks (x - x == 0 holds exactly for finite
+// x); only a chunk that holds a bad particle is searched particle by particle.
+template <int D, class Real>
+inline std::size_t first_unsound(const ParticleView<D, Real>& P, std::size_t lo, std::size_t hi) {
+  constexpr std::size_t kChunk = 512;
+  const Real* __restrict V = P.V;
+  const Real* __restrict s0 = P.s[0];
+  for (std::size_t b = lo; b < hi; b += kChunk) {
+    const std::size_t e = std::min(hi, b + kChunk);
+    int good = 1;
+    for (std::size_t p = b; p < e; ++p) {
+      const Real v = V[p], s = s0[p];
+      good &= int(v > Real(0)) & int(v - v == Real(0)) & int(s - s == Real(0));
+    }
+    const bool bad = good == 0;
+    if (bad)
+      for (std::size_t p = b; p < e; ++p)
+        if (!particle_sound(P, p)) return p;
+  }
+  return SIZE_MAX;
 }
 
 // The fused update (kernels/g2p.hpp kStressUpdate) for scenes whose

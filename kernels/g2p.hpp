@@ -73,12 +73,14 @@ struct G2PGather {
     if constexpr (Windowed) offsets = Win::offsets(grid);
   }
 
-  [[gnu::always_inline]] bool build(const ParticleView<D, Real>& P, std::size_t p,
-                                    Weights& w) const {
+  // A batch of weights (kernels/weight_batch.hpp): windows through
+  // WindowBuilder::build_batch, stencils one by one.
+  [[gnu::always_inline]] void build_batch(const ParticleView<D, Real>& P, std::size_t first,
+                                          std::size_t n, Weights* w, bool* ok) const {
     if constexpr (Windowed)
-      return builder.build(P, p, w);
+      builder.build_batch(P, first, n, w, ok);
     else
-      return w.build(P, grid_, inv_h_, p);
+      for (std::size_t i = 0; i < n; ++i) ok[i] = w[i].build(P, grid_, inv_h_, first + i);
   }
 
   // vn, dv: velocity and its change over the step; L row-major dv_a/dx_b.
@@ -206,9 +208,8 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
       }
     }
   };
-  auto build = [&](std::size_t p, Weights & w) __attribute__((always_inline)) {
-    return st.build(P, p, w);
-  };
+  auto build = [&](std::size_t first, std::size_t n, Weights* w, bool* ok)
+      __attribute__((always_inline)) { st.build_batch(P, first, n, w, ok); };
   auto transfer = [&](std::size_t p, const Weights* weights) __attribute__((always_inline)) {
     if (!weights) {
       if (r.bad == SIZE_MAX) r.bad = p;
@@ -288,16 +289,17 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
   return r;
 }
 
-// The solver's G2P: windowed for the 4-node windows and for 3D linear;
-// pointwise for 2D linear (bench: node by node beats the 4-lane window's
-// horizontal sums there, 12.7 vs 13.6 ns/particle; in 3D the 8-lane window
-// wins, 31 vs 77) and for grids too small for a window.
+// The solver's G2P: windowed, and pointwise (node by node) only for grids
+// too small for a window. 2D linear was pointwise while its windows were
+// built particle by particle (12.7 vs 13.6 ns/particle); with the windows
+// built a batch at a time (WindowBuilder::build_batch) the window wins
+// there too (docs/performance.md "Linear windows a batch at a time").
 template <int D, class Shape, class Real, unsigned What, bool MultiField, bool Traction,
           bool Gravity, class KeyFn, class StressFn = NoStressUpdate>
 G2PRangeResult g2p_range(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
                          const GridVelocity<D, Real>& V, const G2PParams& q, const KeyFn& key_of,
                          std::size_t begin, std::size_t end, const StressFn& stress = {}) {
-  if ((!Window<D, Shape, Real>::flat || D == 3) && Window<D, Shape, Real>::fits(G))
+  if (Window<D, Shape, Real>::fits(G))
     return g2p_range_impl<D, Shape, Real, What, MultiField, Traction, Gravity, true>(
         P, G, V, q, key_of, begin, end, stress);
   return g2p_range_impl<D, Shape, Real, What, MultiField, Traction, Gravity, false>(

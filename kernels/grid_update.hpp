@@ -2,11 +2,13 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 
 #include "kernels/grid_view.hpp"
 #include "kernels/node_ownership.hpp"
+#include "kernels/reduce.hpp"
 
 namespace mmpm {
 
@@ -26,6 +28,64 @@ struct GridUpdateParams {
   bool has_interface_force = false;
 };
 
+namespace detail {
+
+// grid_update on nodes [b, e) of a deformable field, as a loop the compiler
+// vectorises: heavy and sliver nodes computed alike and selected, no branch
+// per node. Why: the branchy loop with the damping sum ran scalar, ~3x the
+// time of this one (grid stage of the 2D linear step, docs/performance.md
+// "Node loops"). When pv is given, node n's p.p/m goes to pv[n - b] (0 for
+// slivers), and the caller sums them in node order, the order of the
+// scalar loop, so the damping loss keeps its bits.
+template <int D, class Real, bool Interface, bool Damping>
+void update_deformable(const GridView<D, Real>& G, const GridVelocity<D, Real>& V, std::size_t o,
+                       std::size_t b, std::size_t e, Real dt, Real alpha, Real thr,
+                       const Real (&gacc)[D], double* __restrict pv) {
+  const Real* __restrict m_ = G.m + o;
+  Real* __restrict p_[D];
+  const Real* __restrict f_[D];
+  const Real* __restrict fi_[D];
+  Real* __restrict dv_[D];
+  for (int d = 0; d < D; ++d) {
+    p_[d] = G.p[d] + o;
+    f_[d] = G.f[d] + o;
+    fi_[d] = Interface ? G.fi[d] + o : nullptr;
+    dv_[d] = V.dvel[d] + o;
+  }
+#pragma GCC ivdep
+  for (std::size_t n = b; n < e; ++n) {
+    const Real m = m_[n];
+    const bool heavy = m > thr;
+    // A sliver of mass (a particle barely reaching the node): its velocity
+    // is not trusted (vel = 0 for positions and strain rates), but the
+    // force it collects still reaches the particles as a FLIP increment
+    // S dt f / m (finite: S ~ m), or momentum would be lost at every uGIMP
+    // surface. m = 0 gives 0/0 here, which the select drops.
+    const bool some = m > Real(0);
+    const Real inv_m = Real(1) / m;
+    double sum = 0;
+    for (int d = 0; d < D; ++d) {
+      const Real p = p_[d][n];
+      // The per-node formulas (§2) with every multiply-add an explicit fma:
+      // left to -ffp-contract, GCC fused them differently in the vector
+      // loop (where the select makes an add conditional) and in its scalar
+      // remainder, so a node's bits depended on where a thread's range
+      // began (tests/test_node_ownership.cpp caught it).
+      Real force = std::fma(m, gacc[d], f_[d][n]);
+      Real damped = std::fma(-alpha, p, force);
+      if constexpr (Interface) force += fi_[d][n], damped += fi_[d][n];
+      const Real sliver = some ? dt * force / m : Real(0);
+      const Real updated = std::fma(dt, damped, p);
+      dv_[d][n] = heavy ? -p * inv_m : sliver;
+      p_[d][n] = heavy ? updated : p;
+      sum = std::fma(double(p) * double(p), double(inv_m), sum);
+    }
+    if constexpr (Damping) pv[n - b] = heavy ? sum : 0.0;
+  }
+}
+
+}  // namespace detail
+
 // p <- p + dt (f + f_interface + m g - alpha p); stores -v_old in dvel.
 // Returns the energy removed by grid damping this step (deterministic sum).
 // Each thread updates the nodes it owns (kernels/node_ownership.hpp).
@@ -35,42 +95,38 @@ double grid_update(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
   const Real dt = Real(q.dt), alpha = Real(q.damping), thr = Real(q.mass_threshold);
   auto body = [&](int f, std::size_t b, std::size_t e, std::array<double, 1>& acc) {
     const std::size_t o = std::size_t(f) * G.nodes;
-    const bool rigid = q.rigid && q.rigid[f];
-    Real gacc[D];
-    for (int d = 0; d < D; ++d) gacc[d] = rigid ? Real(0) : Real(q.body_accel[d]);
-    for (std::size_t n = b; n < e; ++n) {
-      const std::size_t i = o + n;
-      const Real m = G.m[i];
-      if (!(m > thr)) {
-        // A sliver of mass (a particle barely reaching the node): its
-        // velocity is not trusted (vel = 0 for positions and strain
-        // rates), but the force it collects still reaches the particles
-        // as a FLIP increment S dt f / m (finite: S ~ m), or momentum
-        // would be lost at every uGIMP surface.
-        const bool some = m > Real(0) && !rigid;
+    if (q.rigid && q.rigid[f]) {
+      // Prescribed motion (ALGORITHM §7): p = m v_rigid; no force, no loss.
+      for (std::size_t n = b; n < e; ++n) {
+        const std::size_t i = o + n;
+        const Real m = G.m[i];
+        const Real inv_m = Real(1) / m;
         for (int d = 0; d < D; ++d) {
-          Real force = G.f[d][i] + m * gacc[d];
-          if (q.has_interface_force) force += G.fi[d][i];
-          V.dvel[d][i] = some ? dt * force / m : Real(0);
+          const Real p = G.p[d][i];
+          if (m > thr) {
+            V.dvel[d][i] = -p * inv_m;
+            G.p[d][i] = m * Real(q.rigid_velocity[f][d]);
+          } else {
+            V.dvel[d][i] = Real(0);
+          }
         }
-        continue;
       }
-      const Real inv_m = Real(1) / m;
-      double pv = 0;
-      for (int d = 0; d < D; ++d) {
-        const Real p = G.p[d][i];
-        V.dvel[d][i] = -p * inv_m;
-        if (rigid) {
-          G.p[d][i] = m * Real(q.rigid_velocity[f][d]);
-          continue;
-        }
-        Real force = G.f[d][i] + m * gacc[d] - alpha * p;
-        if (q.has_interface_force) force += G.fi[d][i];
-        G.p[d][i] = p + dt * force;
-        pv += double(p) * double(p) * double(inv_m);
-      }
-      acc[0] += double(alpha) * double(dt) * pv;
+      return;
     }
+    Real gacc[D];
+    for (int d = 0; d < D; ++d) gacc[d] = Real(q.body_accel[d]);
+    // Damping: p.p/m per node, summed below in node order.
+    double pv[kReduceChunk];
+    const bool damping = q.damping != 0;
+    auto run = [&]<bool I, bool Dmp>() {
+      detail::update_deformable<D, Real, I, Dmp>(G, V, o, b, e, dt, alpha, thr, gacc, pv);
+    };
+    if (q.has_interface_force)
+      damping ? run.template operator()<true, true>() : run.template operator()<true, false>();
+    else
+      damping ? run.template operator()<false, true>() : run.template operator()<false, false>();
+    if (damping)
+      for (std::size_t n = 0; n < e - b; ++n) acc[0] += double(alpha) * double(dt) * pv[n];
   };
   double loss = 0;
   for (const auto& field_loss : owned_field_sums<1>(own, G.nodes, G.fields, body))
@@ -85,17 +141,23 @@ void grid_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
                      const NodeOwnership& own = {}) {
 #pragma omp parallel if (G.nodes * std::size_t(G.fields) >= kParallelMin)
   for_own_nodes(own, G.nodes, G.fields, [&](std::size_t b, std::size_t e) {
+    // Selects instead of a branch per node, through restrict pointers: a
+    // loop the compiler vectorises (the branchy one ran scalar).
+    const Real* __restrict m_ = G.m;
+    const Real* __restrict p_[D];
+    Real* __restrict vel_[D];
+    Real* __restrict dv_[D];
+    for (int d = 0; d < D; ++d) p_[d] = G.p[d], vel_[d] = V.vel[d], dv_[d] = V.dvel[d];
+#pragma GCC ivdep
     for (std::size_t i = b; i < e; ++i) {
-      const Real m = G.m[i];
-      if (m > thr) {
-        const Real inv_m = Real(1) / m;
-        for (int d = 0; d < D; ++d) {
-          const Real v = G.p[d][i] * inv_m;
-          V.vel[d][i] = v;
-          V.dvel[d][i] += v;
-        }
-      } else {
-        for (int d = 0; d < D; ++d) V.vel[d][i] = Real(0);  // dvel: set by grid_update
+      const Real m = m_[i];
+      const bool heavy = m > thr;
+      const Real inv_m = Real(1) / m;
+      for (int d = 0; d < D; ++d) {
+        // dvel + p/m as an explicit fma (see update_deformable).
+        const Real v = p_[d][i] * inv_m, dv = std::fma(p_[d][i], inv_m, dv_[d][i]);
+        vel_[d][i] = heavy ? v : Real(0);
+        dv_[d][i] = heavy ? dv : dv_[d][i];  // slivers: set by grid_update
       }
     }
   });

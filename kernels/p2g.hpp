@@ -99,8 +99,10 @@ std::size_t p2g_range_grouped(const ParticleView<D, Real>& particles, const Grid
   std::size_t base[kWeightBatch];
   for (std::size_t first = begin; first < end; first += kWeightBatch) {
     const std::size_t n = std::min(kWeightBatch, end - first);
+    bool inside[kWeightBatch];
+    builder.build_batch(P, first, n, w, inside);
     std::size_t ok = 0;
-    while (ok < n && builder.build(P, first + ok, w[ok])) ++ok;
+    while (ok < n && inside[ok]) ++ok;
     for (std::size_t i = 0; i < ok; ++i) {
       base[i] = w[i].base + field_offset<MultiField>(P, G, first + i);
       q[i] = scatter_source<D, Real, What, Traction>(P, opt, inv_t, first + i);
@@ -128,9 +130,8 @@ std::size_t p2g_range_one_block(const ParticleView<D, Real>& particles,
   const auto off = Win::offsets(G);
   Block block;
   const WindowBuilder<D, Shape, Real> builder(G);
-  auto build = [&](std::size_t p, Win & w) __attribute__((always_inline)) {
-    return builder.build(P, p, w);
-  };
+  auto build = [&](std::size_t first, std::size_t n, Win* w, bool* ok)
+      __attribute__((always_inline)) { builder.build_batch(P, first, n, w, ok); };
   auto scatter = [&](std::size_t p, const Win* win) __attribute__((always_inline)) {
     if (!win) return false;
     block.at(win->base + field_offset<MultiField>(P, G, p), G, off);

@@ -17,13 +17,14 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <type_traits>
 
 namespace mmpm {
 
 inline constexpr std::size_t kWeightBatch = 32;
 
 // For p in [begin, end): build(p, w) fills w and says whether p is on the
-// grid, then body(p, w or nullptr) runs the transfer and says whether to go
+// grid (or build(first, n, w, ok) does so for a whole batch), then body(p, w or nullptr) runs the transfer and says whether to go
 // on; after each batch, after_batch(first, n, w, ok) sees the batch's
 // windows (a second pass over them, kernels/g2p.hpp). Returns the particle
 // the body stopped at, or end.
@@ -35,7 +36,11 @@ template <class Weights, class Build, class Body, class AfterBatch>
   bool ok[kWeightBatch];
   for (std::size_t first = begin; first < end; first += kWeightBatch) {
     const std::size_t n = std::min(kWeightBatch, end - first);
-    for (std::size_t i = 0; i < n; ++i) ok[i] = build(first + i, w[i]);
+    // build(first, n, w, ok) builds the batch at once (WindowBuilder::build_batch).
+    if constexpr (std::is_invocable_v<Build&, std::size_t, std::size_t, Weights*, bool*>)
+      build(first, n, static_cast<Weights*>(w), static_cast<bool*>(ok));
+    else
+      for (std::size_t i = 0; i < n; ++i) ok[i] = build(first + i, w[i]);
     for (std::size_t i = 0; i < n; ++i)
       if (!body(first + i, ok[i] ? &w[i] : nullptr)) return first + i;
     after_batch(first, n, static_cast<const Weights*>(w), static_cast<const bool*>(ok));

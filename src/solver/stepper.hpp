@@ -136,6 +136,10 @@ class Stepper final : public Simulation {
   bool domain_gradient_ = false;    // some interaction's normal needs g (P-33)
   bool fuse_constitutive_ = false;  // scene's choice and every stressed material isotropic
   std::vector<typename IsotropicStressUpdate<D, Real>::Entry> stress_table_;  // per material
+  // Several materials, all isotropic in plane strain (or 3D): one contiguous
+  // constitutive loop with per-material constants, no particle lists.
+  bool isotropic_by_material_ = false;
+  IsotropicByMaterial<D, Real> isotropic_table_;
 
   ColumnSet<Real> pcols_, gcols_;
   std::vector<std::uint8_t> scratch_bytes_;

@@ -148,7 +148,19 @@ void Stepper<D, Shape, Real>::setup_particles(const ParticleSeeds& seeds) {
                                    " is too close to the grid edge for the '" + Shape::name +
                                    "' shape function: enlarge the grid"));
   const std::size_t nm = materials_.size();
-  if (nm > 1 && !fuse_constitutive_) material_particles_.resize(nm);
+  isotropic_by_material_ = nm > 1 && nm <= isotropic_table_.lam.size();
+  isotropic_table_.dt = Real(dt_);
+  for (std::size_t i = 0; i < nm; ++i) {
+    const MaterialModel& mat = materials_[i];
+    if (mat.type != MaterialType::isotropic || mat.k.plane_stress) {
+      isotropic_by_material_ = false;
+      break;
+    }
+    const IsotropicPoint<D, Real> point(mat.k, dt_);
+    isotropic_table_.lam[i] = point.lam;
+    isotropic_table_.mu2[i] = point.mu2;
+  }
+  if (nm > 1 && !fuse_constitutive_ && !isotropic_by_material_) material_particles_.resize(nm);
   dirty_ = true;
 }
 
@@ -394,7 +406,8 @@ void Stepper<D, Shape, Real>::constitutive() {
   {
     const auto [lo, hi] =
         thread_block(n, std::size_t(omp_get_num_threads()), std::size_t(omp_get_thread_num()));
-    for (std::size_t mi = 0; mi < materials_.size(); ++mi) {
+    if (isotropic_by_material_) isotropic_table_.range(P_, lo, hi);
+    for (std::size_t mi = 0; mi < materials_.size() && !isotropic_by_material_; ++mi) {
       const MaterialModel& mat = materials_[mi];
       const std::uint32_t* idx = nullptr;
       std::size_t first = lo, last = hi;
@@ -418,8 +431,7 @@ void Stepper<D, Shape, Real>::constitutive() {
           break;
       }
     }
-    for (std::size_t p = lo; p < hi; ++p)
-      if (!particle_sound(P_, p)) bad = std::min(bad, p);
+    bad = std::min(bad, first_unsound(P_, lo, hi));
   }
   if (bad != SIZE_MAX) fail_particle("constitutive", bad, "J <= 0 or a non-finite stress/volume");
 }

@@ -1,0 +1,138 @@
+// WindowBuilder::build_batch (kernels/window.hpp) gives, particle by
+// particle, bitwise the window of WindowBuilder::build and the same on-grid
+// verdict: it computes the window bases and distances of a whole batch in a
+// loop vectorised across particles, and must not change any transfer's
+// result.
+//
+// Particles: seeded random positions over the grid and one cell beyond it
+// on every side, plus positions exactly on each direction's limits (the
+// lowest allowed xi, which is in, and n - margin, which is out), NaN, +-inf
+// and 1e30 (a wild position must be rejected, not converted to int). uGIMP
+// half-widths vary per particle. Every shape, 2D and 3D, double and float;
+// batch sizes 1, 7 and 32 (kWeightBatch) from varying first particles.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "kernels/shape.hpp"
+#include "kernels/window.hpp"
+
+namespace {
+
+using namespace mmpm;
+
+template <int D_, class Shape_, class Real_>
+struct Cfg {
+  static constexpr int D = D_;
+  using Shape = Shape_;
+  using Real = Real_;
+};
+
+template <class C>
+class WindowBatch : public ::testing::Test {};
+
+using Configs = ::testing::Types<
+    Cfg<2, LinearShape, double>, Cfg<2, LinearShape, float>, Cfg<2, GimpShape, double>,
+    Cfg<2, GimpShape, float>, Cfg<2, BSpline2Shape, double>, Cfg<2, BSpline3Shape, float>,
+    Cfg<3, LinearShape, double>, Cfg<3, GimpShape, double>, Cfg<3, GimpShape, float>,
+    Cfg<3, BSpline2Shape, double>, Cfg<3, BSpline3Shape, double>>;
+struct CfgNames {
+  template <class C>
+  static std::string GetName(int) {
+    return std::to_string(C::D) + "D_" + C::Shape::name + "_" +
+           (sizeof(typename C::Real) == 8 ? "double" : "float");
+  }
+};
+TYPED_TEST_SUITE(WindowBatch, Configs, CfgNames);
+
+TYPED_TEST(WindowBatch, SameWindowsAndVerdictsAsOneByOne) {
+  constexpr int D = TypeParam::D;
+  using Shape = typename TypeParam::Shape;
+  using Real = typename TypeParam::Real;
+  using Builder = WindowBuilder<D, Shape, Real>;
+  using Win = Window<D, Shape, Real>;
+
+  GridView<D, Real> G;
+  const int cells[3] = {12, 9, 7};
+  const double h[3] = {0.5, 0.25, 0.75}, origin[3] = {-1.0, 2.0, 0.5};
+  G.nodes = 1;
+  for (int d = 0; d < D; ++d) {
+    G.nodes_per_dim[std::size_t(d)] = cells[d] + 1;
+    G.h[std::size_t(d)] = Real(h[d]);
+    G.origin[std::size_t(d)] = Real(origin[d]);
+    G.nodes *= std::size_t(cells[d] + 1);
+  }
+
+  // Positions: random, then the special ones in direction 0 (mid-grid in the
+  // others).
+  const std::size_t n_random = 600;
+  std::vector<double> special_xi = {Builder::kLoXi,
+                                    double(cells[0] + 1) - Builder::kHiMargin,
+                                    std::nextafter(double(Builder::kLoXi), -1.0),
+                                    0.0,
+                                    double(cells[0]),
+                                    std::numeric_limits<double>::quiet_NaN(),
+                                    std::numeric_limits<double>::infinity(),
+                                    -std::numeric_limits<double>::infinity(),
+                                    1e30,
+                                    -1e30};
+  const std::size_t n = n_random + special_xi.size();
+  std::vector<Real> x[D], lp[D];
+  ParticleView<D, Real> P;
+  P.n = n;
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int d = 0; d < D; ++d) {
+    x[d].resize(n);
+    lp[d].resize(n);
+    for (std::size_t p = 0; p < n; ++p) {
+      const double xi = -1.0 + (cells[d] + 2.0) * u(rng);  // one cell beyond each side
+      x[d][p] = Real(origin[d] + xi * h[d]);
+      lp[d][p] = Real(0.1 + 0.15 * u(rng));
+    }
+    P.x[std::size_t(d)] = x[d].data();
+    if (std::is_same_v<Shape, GimpShape>) P.lp[std::size_t(d)] = lp[d].data();
+  }
+  for (std::size_t k = 0; k < special_xi.size(); ++k) {
+    x[0][n_random + k] = Real(origin[0] + special_xi[k] * h[0]);
+    for (int d = 1; d < D; ++d) x[d][n_random + k] = Real(origin[d] + 0.5 * cells[d] * h[d]);
+  }
+
+  const Builder builder(G);
+  std::vector<Win> one(n);
+  std::vector<char> one_ok(n);
+  std::size_t inside = 0;
+  for (std::size_t p = 0; p < n; ++p) {
+    one_ok[p] = builder.build(P, p, one[p]);
+    inside += one_ok[p] != 0;
+  }
+  // Both verdicts occur, and the lowest allowed xi is on the grid.
+  EXPECT_GT(inside, n / 5);
+  EXPECT_LT(inside, n);
+  EXPECT_TRUE(one_ok[n_random]);
+  EXPECT_FALSE(one_ok[n_random + 1]);
+
+  for (std::size_t batch : {std::size_t(1), std::size_t(7), kWeightBatch}) {
+    for (std::size_t first = 0; first < n; first += batch) {
+      const std::size_t count = std::min(batch, n - first);
+      Win w[kWeightBatch];
+      bool ok[kWeightBatch];
+      builder.build_batch(P, first, count, w, ok);
+      for (std::size_t i = 0; i < count; ++i) {
+        const std::size_t p = first + i;
+        ASSERT_EQ(ok[i], one_ok[p] != 0) << "particle " << p << ", batch " << batch;
+        if (!ok[i]) continue;
+        ASSERT_EQ(w[i].base, one[p].base) << "particle " << p;
+        ASSERT_EQ(std::memcmp(&w[i].wa, &one[p].wa, sizeof(w[i].wa)), 0) << "particle " << p;
+        ASSERT_EQ(std::memcmp(&w[i].dwa, &one[p].dwa, sizeof(w[i].dwa)), 0) << "particle " << p;
+      }
+    }
+  }
+}
+
+}  // namespace
