@@ -26,6 +26,10 @@ struct GridUpdateParams {
   const unsigned char* rigid = nullptr;         // per field
   const double (*rigid_velocity)[3] = nullptr;  // per field, at t + dt
   bool has_interface_force = false;
+  // Also set vel = p/m and complete dvel (what grid_velocities does) in the
+  // same pass: for steps where nothing changes p in between (no
+  // multimaterial pass B). Bitwise the two separate passes.
+  bool velocities = false;
 };
 
 namespace detail {
@@ -37,7 +41,7 @@ namespace detail {
 // "Node loops"). When pv is given, node n's p.p/m goes to pv[n - b] (0 for
 // slivers), and the caller sums them in node order, the order of the
 // scalar loop, so the damping loss keeps its bits.
-template <int D, class Real, bool Interface, bool Damping>
+template <int D, class Real, bool Interface, bool Damping, bool Velocities>
 void update_deformable(const GridView<D, Real>& G, const GridVelocity<D, Real>& V, std::size_t o,
                        std::size_t b, std::size_t e, Real dt, Real alpha, Real thr,
                        const Real (&gacc)[D], double* __restrict pv) {
@@ -46,11 +50,13 @@ void update_deformable(const GridView<D, Real>& G, const GridVelocity<D, Real>& 
   const Real* __restrict f_[D];
   const Real* __restrict fi_[D];
   Real* __restrict dv_[D];
+  Real* __restrict vel_[D];
   for (int d = 0; d < D; ++d) {
     p_[d] = G.p[d] + o;
     f_[d] = G.f[d] + o;
     fi_[d] = Interface ? G.fi[d] + o : nullptr;
     dv_[d] = V.dvel[d] + o;
+    vel_[d] = Velocities ? V.vel[d] + o : nullptr;
   }
 #pragma GCC ivdep
   for (std::size_t n = b; n < e; ++n) {
@@ -76,7 +82,13 @@ void update_deformable(const GridView<D, Real>& G, const GridVelocity<D, Real>& 
       if constexpr (Interface) force += fi_[d][n], damped += fi_[d][n];
       const Real sliver = some ? dt * force / m : Real(0);
       const Real updated = std::fma(dt, damped, p);
-      dv_[d][n] = heavy ? -p * inv_m : sliver;
+      if constexpr (Velocities) {
+        // grid_velocities' formulas on the updated momentum.
+        vel_[d][n] = heavy ? updated * inv_m : Real(0);
+        dv_[d][n] = heavy ? std::fma(updated, inv_m, -p * inv_m) : sliver;
+      } else {
+        dv_[d][n] = heavy ? -p * inv_m : sliver;
+      }
       p_[d][n] = heavy ? updated : p;
       sum = std::fma(double(p) * double(p), double(inv_m), sum);
     }
@@ -86,8 +98,8 @@ void update_deformable(const GridView<D, Real>& G, const GridVelocity<D, Real>& 
 
 }  // namespace detail
 
-// p <- p + dt (f + f_interface + m g - alpha p); stores -v_old in dvel.
-// Returns the energy removed by grid damping this step (deterministic sum).
+// p <- p + dt (f + f_interface + m g - alpha p); stores -v_old in dvel
+// (with q.velocities: also vel, and dvel = v_new - v_old). Returns the energy removed by grid damping this step (deterministic sum).
 // Each thread updates the nodes it owns (kernels/node_ownership.hpp).
 template <int D, class Real>
 double grid_update(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
@@ -104,10 +116,16 @@ double grid_update(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
         for (int d = 0; d < D; ++d) {
           const Real p = G.p[d][i];
           if (m > thr) {
+            const Real rigid_p = m * Real(q.rigid_velocity[f][d]);
             V.dvel[d][i] = -p * inv_m;
-            G.p[d][i] = m * Real(q.rigid_velocity[f][d]);
+            G.p[d][i] = rigid_p;
+            if (q.velocities) {
+              V.vel[d][i] = rigid_p * inv_m;
+              V.dvel[d][i] = std::fma(rigid_p, inv_m, -p * inv_m);
+            }
           } else {
             V.dvel[d][i] = Real(0);
+            if (q.velocities) V.vel[d][i] = Real(0);
           }
         }
       }
@@ -119,7 +137,10 @@ double grid_update(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
     double pv[kReduceChunk];
     const bool damping = q.damping != 0;
     auto run = [&]<bool I, bool Dmp>() {
-      detail::update_deformable<D, Real, I, Dmp>(G, V, o, b, e, dt, alpha, thr, gacc, pv);
+      if (q.velocities)
+        detail::update_deformable<D, Real, I, Dmp, true>(G, V, o, b, e, dt, alpha, thr, gacc, pv);
+      else
+        detail::update_deformable<D, Real, I, Dmp, false>(G, V, o, b, e, dt, alpha, thr, gacc, pv);
     };
     if (q.has_interface_force)
       damping ? run.template operator()<true, true>() : run.template operator()<true, false>();

@@ -463,6 +463,8 @@ void Stepper<D, Shape, Real>::grid_update_stage() {
   q.rigid = plan_.rigid.data();
   q.rigid_velocity = reinterpret_cast<const double(*)[3]>(rigid_velocity_now_.data());
   q.has_interface_force = mm_.has_interface_forces();
+  // Without pass B nothing changes p before the velocities: one pass.
+  q.velocities = !plan_.multimaterial;
   damping_loss_ += grid_update(G_, GV_, q, own_);
 }
 
@@ -621,7 +623,10 @@ void Stepper<D, Shape, Real>::step() {
     toc(kStageMultimaterial);
   }
   tic();
-  finish_velocities(true);
+  if (mm)
+    finish_velocities(true);
+  else
+    apply_boundaries(true);  // grid_update_stage set the velocities
   toc(kStageGrid);
 
   if (scheme == Scheme::USL) {

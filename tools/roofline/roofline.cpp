@@ -146,7 +146,10 @@ int main(int argc, char** argv) {
     const bool gimp = std::strcmp(c.shape, "gimp") == 0;
     // Compulsory traffic per particle (docs/performance.md).
     const double grid_per_p = nn / np * R * 2.0;  // one array read + written once per step
-    const double p2g_bytes = R * (2 * D + 2 + NS + (gimp ? D : 0)) + grid_per_p * (1 + 2 * D);
+    // The force needs the in-plane stresses only: 3 of the 4 in 2D (not zz).
+    const int NS_force = D == 2 ? 3 : 6;
+    const double p2g_bytes =
+        R * (2 * D + 2 + NS_force + (gimp ? D : 0)) + grid_per_p * (1 + 2 * D);
     const double g2p_bytes =
         R * (2 * D + (gimp ? D : 0)) + 4 + R * (2 * D + D * D) + grid_per_p / 2 * (2 * D);
     const double con_bytes = R * (D * D + NS + 1) + R * (NS + 1);
