@@ -45,6 +45,68 @@ inline Real volume_ratio(const ParticleView<D, Real>& P, std::size_t p, Real dt)
   }
 }
 
+// Lame's lambda and 2 mu of one particle.
+template <class Real>
+struct Moduli {
+  Real lam, mu2;
+};
+
+// The small-strain isotropic update (plane strain in 2D) of particles
+// [first, last), the moduli of particle p from moduli(p): the loop shared
+// by IsotropicPoint::range (one material) and IsotropicByMaterial (a
+// lookup by material). Restrict pointers, no branch: it vectorises. Same
+// arithmetic as IsotropicPoint::operator().
+template <int D, class Real, class ModuliOf>
+[[gnu::always_inline]] inline void isotropic_strain_loop(const ParticleView<D, Real>& P, Real dt,
+                                                         std::size_t first, std::size_t last,
+                                                         const ModuliOf& moduli) {
+  Real* __restrict V = P.V;
+  if constexpr (D == 2) {
+    const Real* __restrict L0 = P.L[0];
+    const Real* __restrict L1 = P.L[1];
+    const Real* __restrict L2 = P.L[2];
+    const Real* __restrict L3 = P.L[3];
+    Real* __restrict s0 = P.s[0];
+    Real* __restrict s1 = P.s[1];
+    Real* __restrict s2 = P.s[2];
+    Real* __restrict s3 = P.s[3];
+#pragma GCC ivdep
+    for (std::size_t p = first; p < last; ++p) {
+      const Moduli<Real> k = moduli(p);
+      const Real exx = dt * L0[p], eyy = dt * L3[p];
+      const Real exy = Real(0.5) * dt * (L1[p] + L2[p]);
+      const Real a = Real(1) + exx, b = dt * L1[p], c = dt * L2[p], d = Real(1) + eyy;
+      const Real tr = k.lam * (exx + eyy);
+      s0[p] += tr + k.mu2 * exx;
+      s1[p] += tr + k.mu2 * eyy;
+      s2[p] += k.mu2 * exy;
+      s3[p] += tr;
+      V[p] *= a * d - b * c;
+    }
+  } else {
+    const Real* __restrict L[9];
+    Real* __restrict s[6];
+    for (int i = 0; i < 9; ++i) L[i] = P.L[i];
+    for (int i = 0; i < 6; ++i) s[i] = P.s[i];
+#pragma GCC ivdep
+    for (std::size_t p = first; p < last; ++p) {
+      const Moduli<Real> k = moduli(p);
+      Real A[9];
+      for (int i = 0; i < 9; ++i) A[i] = dt * L[i][p] + ((i % 4) == 0 ? Real(1) : Real(0));
+      const Real e0 = dt * L[0][p], e1 = dt * L[4][p], e2 = dt * L[8][p];
+      const Real tr = k.lam * (e0 + e1 + e2);
+      s[0][p] += tr + k.mu2 * e0;
+      s[1][p] += tr + k.mu2 * e1;
+      s[2][p] += tr + k.mu2 * e2;
+      s[3][p] += Real(0.5) * k.mu2 * dt * (L[5][p] + L[7][p]);  // yz
+      s[4][p] += Real(0.5) * k.mu2 * dt * (L[2][p] + L[6][p]);  // xz
+      s[5][p] += Real(0.5) * k.mu2 * dt * (L[1][p] + L[3][p]);  // xy
+      V[p] *= A[0] * (A[4] * A[8] - A[5] * A[7]) - A[1] * (A[3] * A[8] - A[5] * A[6]) +
+              A[2] * (A[3] * A[7] - A[4] * A[6]);
+    }
+  }
+}
+
 // Per-particle updates: one functor per material type, applied to particle
 // p. The Stepper's constitutive pass runs them over each thread's block of
 // particles (update_particles); with fuse_constitutive the G2P gradient
@@ -96,65 +158,40 @@ struct IsotropicPoint {
   // the compiler vectorises. Why: called per particle, the update stayed a
   // scalar call (GCC did not inline it, and the view's arrays may alias for
   // all it knows); this loop reads the arrays through restrict pointers
-  // with the plane-stress branch hoisted (2D linear step, 1 thread:
-  // docs/performance.md "Constitutive pass").
+  // with the plane-stress branch hoisted (docs/performance.md "Loops the
+  // compiler vectorises").
   void range(const ParticleView<D, Real>& P, std::size_t first, std::size_t last) const {
-    Real* __restrict V = P.V;
     if constexpr (D == 2) {
-      const Real* __restrict L0 = P.L[0];
-      const Real* __restrict L1 = P.L[1];
-      const Real* __restrict L2 = P.L[2];
-      const Real* __restrict L3 = P.L[3];
-      Real* __restrict s0 = P.s[0];
-      Real* __restrict s1 = P.s[1];
-      Real* __restrict s2 = P.s[2];
-      Real* __restrict s3 = P.s[3];
       if (pstress) {
-        const Real zz = nu / (Real(1) - nu);
-#pragma GCC ivdep
-        for (std::size_t p = first; p < last; ++p) {
-          const Real exx = dt * L0[p], eyy = dt * L3[p];
-          const Real exy = Real(0.5) * dt * (L1[p] + L2[p]);
-          const Real a = Real(1) + exx, b = dt * L1[p], c = dt * L2[p], d = Real(1) + eyy;
-          s0[p] += Ep * (exx + nu * eyy);
-          s1[p] += Ep * (eyy + nu * exx);
-          s2[p] += mu2 * exy;
-          V[p] *= (a * d - b * c) * (Real(1) - zz * (exx + eyy));
-        }
-      } else {
-#pragma GCC ivdep
-        for (std::size_t p = first; p < last; ++p) {
-          const Real exx = dt * L0[p], eyy = dt * L3[p];
-          const Real exy = Real(0.5) * dt * (L1[p] + L2[p]);
-          const Real a = Real(1) + exx, b = dt * L1[p], c = dt * L2[p], d = Real(1) + eyy;
-          const Real tr = lam * (exx + eyy);
-          s0[p] += tr + mu2 * exx;
-          s1[p] += tr + mu2 * eyy;
-          s2[p] += mu2 * exy;
-          s3[p] += tr;
-          V[p] *= a * d - b * c;
-        }
+        plane_stress_range(P, first, last);
+        return;
       }
-    } else {
-      const Real* __restrict L[9];
-      Real* __restrict s[6];
-      for (int i = 0; i < 9; ++i) L[i] = P.L[i];
-      for (int i = 0; i < 6; ++i) s[i] = P.s[i];
+    }
+    isotropic_strain_loop(P, dt, first, last,
+                          [this](std::size_t) { return Moduli<Real>{lam, mu2}; });
+  }
+
+ private:
+  void plane_stress_range(const ParticleView<D, Real>& P, std::size_t first,
+                          std::size_t last) const {
+    Real* __restrict V = P.V;
+    const Real* __restrict L0 = P.L[0];
+    const Real* __restrict L1 = P.L[1];
+    const Real* __restrict L2 = P.L[2];
+    const Real* __restrict L3 = P.L[3];
+    Real* __restrict s0 = P.s[0];
+    Real* __restrict s1 = P.s[1];
+    Real* __restrict s2 = P.s[2];
+    const Real zz = nu / (Real(1) - nu);
 #pragma GCC ivdep
-      for (std::size_t p = first; p < last; ++p) {
-        Real A[9];
-        for (int i = 0; i < 9; ++i) A[i] = dt * L[i][p] + ((i % 4) == 0 ? Real(1) : Real(0));
-        const Real e0 = dt * L[0][p], e1 = dt * L[4][p], e2 = dt * L[8][p];
-        const Real tr = lam * (e0 + e1 + e2);
-        s[0][p] += tr + mu2 * e0;
-        s[1][p] += tr + mu2 * e1;
-        s[2][p] += tr + mu2 * e2;
-        s[3][p] += Real(0.5) * mu2 * dt * (L[5][p] + L[7][p]);  // yz
-        s[4][p] += Real(0.5) * mu2 * dt * (L[2][p] + L[6][p]);  // xz
-        s[5][p] += Real(0.5) * mu2 * dt * (L[1][p] + L[3][p]);  // xy
-        V[p] *= A[0] * (A[4] * A[8] - A[5] * A[7]) - A[1] * (A[3] * A[8] - A[5] * A[6]) +
-                A[2] * (A[3] * A[7] - A[4] * A[6]);
-      }
+    for (std::size_t p = first; p < last; ++p) {
+      const Real exx = dt * L0[p], eyy = dt * L3[p];
+      const Real exy = Real(0.5) * dt * (L1[p] + L2[p]);
+      const Real a = Real(1) + exx, b = dt * L1[p], c = dt * L2[p], d = Real(1) + eyy;
+      s0[p] += Ep * (exx + nu * eyy);
+      s1[p] += Ep * (eyy + nu * exx);
+      s2[p] += mu2 * exy;
+      V[p] *= (a * d - b * c) * (Real(1) - zz * (exx + eyy));
     }
   }
 };
@@ -171,51 +208,8 @@ struct IsotropicByMaterial {
 
   void range(const ParticleView<D, Real>& P, std::size_t first, std::size_t last) const {
     const std::uint8_t* __restrict mat = P.mat;
-    Real* __restrict V = P.V;
-    if constexpr (D == 2) {
-      const Real* __restrict L0 = P.L[0];
-      const Real* __restrict L1 = P.L[1];
-      const Real* __restrict L2 = P.L[2];
-      const Real* __restrict L3 = P.L[3];
-      Real* __restrict s0 = P.s[0];
-      Real* __restrict s1 = P.s[1];
-      Real* __restrict s2 = P.s[2];
-      Real* __restrict s3 = P.s[3];
-#pragma GCC ivdep
-      for (std::size_t p = first; p < last; ++p) {
-        const Real l = lam[mat[p]], m2 = mu2[mat[p]];
-        const Real exx = dt * L0[p], eyy = dt * L3[p];
-        const Real exy = Real(0.5) * dt * (L1[p] + L2[p]);
-        const Real a = Real(1) + exx, b = dt * L1[p], c = dt * L2[p], d = Real(1) + eyy;
-        const Real tr = l * (exx + eyy);
-        s0[p] += tr + m2 * exx;
-        s1[p] += tr + m2 * eyy;
-        s2[p] += m2 * exy;
-        s3[p] += tr;
-        V[p] *= a * d - b * c;
-      }
-    } else {
-      const Real* __restrict L[9];
-      Real* __restrict s[6];
-      for (int i = 0; i < 9; ++i) L[i] = P.L[i];
-      for (int i = 0; i < 6; ++i) s[i] = P.s[i];
-#pragma GCC ivdep
-      for (std::size_t p = first; p < last; ++p) {
-        const Real l = lam[mat[p]], m2 = mu2[mat[p]];
-        Real A[9];
-        for (int i = 0; i < 9; ++i) A[i] = dt * L[i][p] + ((i % 4) == 0 ? Real(1) : Real(0));
-        const Real e0 = dt * L[0][p], e1 = dt * L[4][p], e2 = dt * L[8][p];
-        const Real tr = l * (e0 + e1 + e2);
-        s[0][p] += tr + m2 * e0;
-        s[1][p] += tr + m2 * e1;
-        s[2][p] += tr + m2 * e2;
-        s[3][p] += Real(0.5) * m2 * dt * (L[5][p] + L[7][p]);  // yz
-        s[4][p] += Real(0.5) * m2 * dt * (L[2][p] + L[6][p]);  // xz
-        s[5][p] += Real(0.5) * m2 * dt * (L[1][p] + L[3][p]);  // xy
-        V[p] *= A[0] * (A[4] * A[8] - A[5] * A[7]) - A[1] * (A[3] * A[8] - A[5] * A[6]) +
-                A[2] * (A[3] * A[7] - A[4] * A[6]);
-      }
-    }
+    isotropic_strain_loop(P, dt, first, last,
+                          [&](std::size_t p) { return Moduli<Real>{lam[mat[p]], mu2[mat[p]]}; });
   }
 };
 

@@ -17,17 +17,17 @@
 
 #include <algorithm>
 #include <cstddef>
-#include <type_traits>
 
 namespace mmpm {
 
 inline constexpr std::size_t kWeightBatch = 32;
 
-// For p in [begin, end): build(p, w) fills w and says whether p is on the
-// grid (or build(first, n, w, ok) does so for a whole batch), then body(p, w or nullptr) runs the transfer and says whether to go
-// on; after each batch, after_batch(first, n, w, ok) sees the batch's
-// windows (a second pass over them, kernels/g2p.hpp). Returns the particle
-// the body stopped at, or end.
+// For p in [begin, end), a batch at a time: build(first, n, w, ok) fills
+// the batch's weights w[i] and ok[i] (is particle first + i on the grid),
+// then body(p, w or nullptr) runs the transfer and says whether to go on;
+// after each batch, after_batch(first, n, w, ok) sees the batch's windows
+// (a second pass over them, kernels/g2p.hpp). Returns the particle the body
+// stopped at, or end.
 template <class Weights, class Build, class Body, class AfterBatch>
 [[gnu::always_inline]] inline std::size_t for_each_weighted(std::size_t begin, std::size_t end,
                                                             Build&& build, Body&& body,
@@ -36,11 +36,7 @@ template <class Weights, class Build, class Body, class AfterBatch>
   bool ok[kWeightBatch];
   for (std::size_t first = begin; first < end; first += kWeightBatch) {
     const std::size_t n = std::min(kWeightBatch, end - first);
-    // build(first, n, w, ok) builds the batch at once (WindowBuilder::build_batch).
-    if constexpr (std::is_invocable_v<Build&, std::size_t, std::size_t, Weights*, bool*>)
-      build(first, n, static_cast<Weights*>(w), static_cast<bool*>(ok));
-    else
-      for (std::size_t i = 0; i < n; ++i) ok[i] = build(first + i, w[i]);
+    build(first, n, static_cast<Weights*>(w), static_cast<bool*>(ok));
     for (std::size_t i = 0; i < n; ++i)
       if (!body(first + i, ok[i] ? &w[i] : nullptr)) return first + i;
     after_batch(first, n, static_cast<const Weights*>(w), static_cast<const bool*>(ok));

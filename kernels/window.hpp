@@ -270,7 +270,8 @@ class WindowBuilder {
   }
 
   // The window of particle p into w; false when the particle's stencil
-  // leaves the grid.
+  // leaves the grid. The transfers use build_batch; this one-particle form
+  // is the reference it is tested against (tests/test_window_batch.cpp).
   [[gnu::always_inline]] bool build(const ParticleView<D, Real>& P, std::size_t p, Win& w) const {
     Real r[DP], l[DP];
     std::size_t stride = 1;

@@ -269,19 +269,27 @@ double reference_update(Grid2& g, const GridUpdateParams& q) {
   return loss;
 }
 
-void grid_update_case(bool interface, double damping) {
-  const double thr = 1e-6;
-  Grid2 a(5000, thr, 5), b(5000, thr, 5);
-  const unsigned char rigid[2] = {0, 1};
-  const double rigid_velocity[2][3] = {{0, 0, 0}, {0.25, -0.5, 0}};
+// Field 1 rigid, moving at (0.25, -0.5); gravity; mass threshold 1e-6.
+constexpr double kThreshold = 1e-6;
+const unsigned char kRigid[2] = {0, 1};
+const double kRigidVelocity[2][3] = {{0, 0, 0}, {0.25, -0.5, 0}};
+
+GridUpdateParams update_params(bool interface, double damping) {
   GridUpdateParams q;
   q.dt = 1e-3;
   q.damping = damping;
-  q.mass_threshold = thr;
+  q.mass_threshold = kThreshold;
   q.body_accel[1] = -9.81;
-  q.rigid = rigid;
-  q.rigid_velocity = rigid_velocity;
+  q.rigid = kRigid;
+  q.rigid_velocity = kRigidVelocity;
   q.has_interface_force = interface;
+  return q;
+}
+
+void grid_update_case(bool interface, double damping) {
+  const double thr = kThreshold;
+  Grid2 a(5000, thr, 5), b(5000, thr, 5);
+  const GridUpdateParams q = update_params(interface, damping);
   const double loss = grid_update(a.G, a.V, q);
   const double want = reference_update(b, q);
   for (int d = 0; d < 2; ++d) {
@@ -318,18 +326,9 @@ void grid_update_case(bool interface, double damping) {
 // grid_velocities, bitwise: the Stepper fuses them when no pass B runs in
 // between, and the fused and separate paths must give the same run.
 void fused_velocities_case(bool interface, double damping) {
-  const double thr = 1e-6;
+  const double thr = kThreshold;
   Grid2 a(5000, thr, 9), b(5000, thr, 9);
-  const unsigned char rigid[2] = {0, 1};
-  const double rigid_velocity[2][3] = {{0, 0, 0}, {0.25, -0.5, 0}};
-  GridUpdateParams q;
-  q.dt = 1e-3;
-  q.damping = damping;
-  q.mass_threshold = thr;
-  q.body_accel[1] = -9.81;
-  q.rigid = rigid;
-  q.rigid_velocity = rigid_velocity;
-  q.has_interface_force = interface;
+  GridUpdateParams q = update_params(interface, damping);
   const double separate = grid_update(b.G, b.V, q);
   grid_velocities(b.G, b.V, thr);
   q.velocities = true;

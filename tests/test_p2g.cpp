@@ -55,17 +55,14 @@
 #include "kernels/particle_view.hpp"
 #include "kernels/shape.hpp"
 #include "kernels/weights.hpp"
+#include "tests/shape_configs.hpp"
 
 namespace {
 
 using namespace mmpm;
 
-template <int Dim, class S, class R>
-struct Cfg {
-  static constexpr int D = Dim;
-  using Shape = S;
-  using Real = R;
-};
+using mmpm_test::Cfg;
+using mmpm_test::CfgNames;
 
 constexpr unsigned kAll = kMassMomentum | kForce | kMultimaterial | kDomainGradient;
 
@@ -262,13 +259,6 @@ using Configs = ::testing::Types<
     Cfg<2, LinearShape, double>, Cfg<2, GimpShape, double>, Cfg<2, GimpShape, float>,
     Cfg<2, BSpline2Shape, double>, Cfg<2, BSpline3Shape, float>, Cfg<3, GimpShape, double>,
     Cfg<3, LinearShape, float>, Cfg<3, BSpline2Shape, double>, Cfg<3, BSpline3Shape, double>>;
-struct CfgNames {
-  template <class C>
-  static std::string GetName(int) {
-    return std::to_string(C::D) + "D_" + C::Shape::name + "_" +
-           (sizeof(typename C::Real) == 8 ? "double" : "float");
-  }
-};
 TYPED_TEST_SUITE(P2G, Configs, CfgNames);
 
 template <class Real>

@@ -21,17 +21,14 @@
 
 #include "kernels/shape.hpp"
 #include "kernels/window.hpp"
+#include "tests/shape_configs.hpp"
 
 namespace {
 
 using namespace mmpm;
 
-template <int D_, class Shape_, class Real_>
-struct Cfg {
-  static constexpr int D = D_;
-  using Shape = Shape_;
-  using Real = Real_;
-};
+using mmpm_test::Cfg;
+using mmpm_test::CfgNames;
 
 template <class C>
 class WindowBatch : public ::testing::Test {};
@@ -41,13 +38,6 @@ using Configs = ::testing::Types<
     Cfg<2, GimpShape, float>, Cfg<2, BSpline2Shape, double>, Cfg<2, BSpline3Shape, float>,
     Cfg<3, LinearShape, double>, Cfg<3, GimpShape, double>, Cfg<3, GimpShape, float>,
     Cfg<3, BSpline2Shape, double>, Cfg<3, BSpline3Shape, double>>;
-struct CfgNames {
-  template <class C>
-  static std::string GetName(int) {
-    return std::to_string(C::D) + "D_" + C::Shape::name + "_" +
-           (sizeof(typename C::Real) == 8 ? "double" : "float");
-  }
-};
 TYPED_TEST_SUITE(WindowBatch, Configs, CfgNames);
 
 TYPED_TEST(WindowBatch, SameWindowsAndVerdictsAsOneByOne) {
