@@ -255,7 +255,7 @@ def kernel_section(R):
     ns = "ns_per_particle"
     out = ["## 2. G2P and constitutive update (ns/particle)", "",
            "G2P: FLIP/PIC velocity, position, velocity gradient and the tile-change test, "
-           "as the Stepper runs it (windowed for 4-node shapes and 3D linear, pointwise for 2D linear); "
+           "as the Stepper runs it (windowed for every shape); "
            "pointwise = the node-by-node reference gather. Constitutive: isotropic small-strain "
            "update (plane strain in 2D). Same particle blocks as P2G.", ""]
     header = ["kernel", "dim", "shape", "real", "1 thread", "2 threads", "speed-up",
