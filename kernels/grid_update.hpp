@@ -38,9 +38,9 @@ namespace detail {
 // vectorises: heavy and sliver nodes computed alike and selected, no branch
 // per node. Why: the branchy loop with the damping sum ran scalar, ~3x the
 // time of this one (grid stage of the 2D linear step, docs/performance.md
-// "Node loops"). When pv is given, node n's p.p/m goes to pv[n - b] (0 for
-// slivers), and the caller sums them in node order, the order of the
-// scalar loop, so the damping loss keeps its bits.
+// "Loops the compiler vectorises"). With Damping, node n's p.p/m goes to
+// pv[n - b] (0 for slivers), and the caller sums them in node order, the
+// order of the scalar loop, so the damping loss keeps its bits.
 template <int D, class Real, bool Interface, bool Damping, bool Velocities>
 void update_deformable(const GridView<D, Real>& G, const GridVelocity<D, Real>& V, std::size_t o,
                        std::size_t b, std::size_t e, Real dt, Real alpha, Real thr,
@@ -99,7 +99,8 @@ void update_deformable(const GridView<D, Real>& G, const GridVelocity<D, Real>& 
 }  // namespace detail
 
 // p <- p + dt (f + f_interface + m g - alpha p); stores -v_old in dvel
-// (with q.velocities: also vel, and dvel = v_new - v_old). Returns the energy removed by grid damping this step (deterministic sum).
+// (with q.velocities: also vel, and dvel = v_new - v_old). Returns the
+// energy removed by grid damping this step (deterministic sum).
 // Each thread updates the nodes it owns (kernels/node_ownership.hpp).
 template <int D, class Real>
 double grid_update(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
@@ -117,11 +118,12 @@ double grid_update(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
           const Real p = G.p[d][i];
           if (m > thr) {
             const Real rigid_p = m * Real(q.rigid_velocity[f][d]);
-            V.dvel[d][i] = -p * inv_m;
             G.p[d][i] = rigid_p;
-            if (q.velocities) {
+            if (q.velocities) {  // grid_velocities' formulas, as in update_deformable
               V.vel[d][i] = rigid_p * inv_m;
               V.dvel[d][i] = std::fma(rigid_p, inv_m, -p * inv_m);
+            } else {
+              V.dvel[d][i] = -p * inv_m;
             }
           } else {
             V.dvel[d][i] = Real(0);
