@@ -186,4 +186,30 @@ void grid_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
   });
 }
 
+// vel = p/m alone (no dvel): the velocities of re-extrapolated momenta
+// (MUSL's second transfer, USF's first); slivers get vel = 0. The division
+// runs for every node and the select keeps it where m > thr (m = 0 gives
+// 0/0, dropped): a loop the compiler vectorises, where the branchy one ran
+// scalar, with the bits of p/m unchanged.
+template <int D, class Real>
+void grid_momentum_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V, Real thr,
+                              const NodeOwnership& own = {}) {
+#pragma omp parallel if (G.nodes * std::size_t(G.fields) >= kParallelMin)
+  for_own_nodes(own, G.nodes, G.fields, [&](std::size_t b, std::size_t e) {
+    const Real* __restrict m_ = G.m;
+    const Real* __restrict p_[D];
+    Real* __restrict vel_[D];
+    for (int d = 0; d < D; ++d) p_[d] = G.p[d], vel_[d] = V.vel[d];
+#pragma GCC ivdep
+    for (std::size_t i = b; i < e; ++i) {
+      const Real m = m_[i];
+      const bool heavy = m > thr;
+      for (int d = 0; d < D; ++d) {
+        const Real v = p_[d][i] / m;
+        vel_[d][i] = heavy ? v : Real(0);
+      }
+    }
+  });
+}
+
 }  // namespace mmpm

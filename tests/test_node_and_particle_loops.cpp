@@ -102,7 +102,9 @@ TEST(ConstitutiveLoops, IsotropicRangeMatchesPointwisePlaneStrain) {
 TEST(ConstitutiveLoops, IsotropicRangeMatchesPointwisePlaneStress) {
   range_matches_pointwise<2>(true);
 }
-TEST(ConstitutiveLoops, IsotropicRangeMatchesPointwise3D) { range_matches_pointwise<3>(false); }
+TEST(ConstitutiveLoops, IsotropicRangeMatchesPointwise3D) {
+  range_matches_pointwise<3>(false);
+}
 
 template <int D>
 void by_material_matches_per_material() {
@@ -180,10 +182,10 @@ TEST(ConstitutiveLoops, FirstUnsoundFindsTheFirstBadParticle) {
     bool volume;  // else stress
     double value;
   };
-  const Bad kinds[] = {{true, 0.0}, {true, -1e-30}, {true, nan}, {true, inf},
-                       {false, nan}, {false, -inf}};
-  for (std::size_t at : {std::size_t(0), std::size_t(511), std::size_t(512), std::size_t(1100),
-                         n - 1})
+  const Bad kinds[] = {{true, 0.0}, {true, -1e-30}, {true, nan},
+                       {true, inf}, {false, nan},   {false, -inf}};
+  for (std::size_t at :
+       {std::size_t(0), std::size_t(511), std::size_t(512), std::size_t(1100), n - 1})
     for (const Bad& k : kinds) {
       Particles<2> a(n, 1, 3);
       EXPECT_EQ(first_unsound(a.P, 0, n), SIZE_MAX);
@@ -335,8 +337,8 @@ void fused_velocities_case(bool interface, double damping) {
   const double fused = grid_update(a.G, a.V, q);
   EXPECT_EQ(fused, separate);
   for (int d = 0; d < 2; ++d)
-    for (auto [x, y] : {std::pair{&a.p[d], &b.p[d]}, {&a.vel[d], &b.vel[d]},
-                        {&a.dvel[d], &b.dvel[d]}})
+    for (auto [x, y] :
+         {std::pair{&a.p[d], &b.p[d]}, {&a.vel[d], &b.vel[d]}, {&a.dvel[d], &b.dvel[d]}})
       EXPECT_EQ(std::memcmp(x->data(), y->data(), x->size() * sizeof(double)), 0);
 }
 
@@ -346,9 +348,40 @@ TEST(GridLoops, FusedVelocitiesEqualSeparatePassBitwise) {
   fused_velocities_case(true, 0.7);
 }
 
-TEST(GridLoops, UpdateMatchesPerNodeFormulas) { grid_update_case(false, 0.0); }
-TEST(GridLoops, UpdateMatchesPerNodeFormulasWithInterfaceForces) { grid_update_case(true, 0.0); }
-TEST(GridLoops, UpdateMatchesPerNodeFormulasWithDamping) { grid_update_case(false, 0.7); }
+// grid_momentum_velocities = the branchy per-node division, bitwise: vel =
+// p/m on heavy nodes, 0 on slivers and empty nodes (0/0 dropped), dvel and
+// p untouched.
+TEST(GridLoops, MomentumVelocitiesEqualPerNodeDivisionBitwise) {
+  const double thr = kThreshold;
+  Grid2 a(5003, thr, 11);
+  for (int d = 0; d < 2; ++d) std::fill(a.vel[d].begin(), a.vel[d].end(), 123.0);
+  const auto dvel_before = a.dvel[0];
+  const auto p_before = a.p[1];
+  grid_momentum_velocities(a.G, a.V, thr);
+  std::size_t heavy = 0, empty = 0;
+  for (std::size_t i = 0; i < a.m.size(); ++i) {
+    heavy += a.m[i] > thr;
+    empty += a.m[i] == 0.0;
+    for (int d = 0; d < 2; ++d) {
+      const double want = a.m[i] > thr ? a.p[d][i] / a.m[i] : 0.0;
+      ASSERT_EQ(std::memcmp(&a.vel[d][i], &want, sizeof want), 0) << "node " << i;
+    }
+  }
+  EXPECT_GT(heavy, 1000u);  // the case mix is real: heavy, sliver and empty nodes
+  EXPECT_GT(empty, 500u);
+  EXPECT_EQ(a.dvel[0], dvel_before);
+  EXPECT_EQ(a.p[1], p_before);
+}
+
+TEST(GridLoops, UpdateMatchesPerNodeFormulas) {
+  grid_update_case(false, 0.0);
+}
+TEST(GridLoops, UpdateMatchesPerNodeFormulasWithInterfaceForces) {
+  grid_update_case(true, 0.0);
+}
+TEST(GridLoops, UpdateMatchesPerNodeFormulasWithDamping) {
+  grid_update_case(false, 0.7);
+}
 TEST(GridLoops, UpdateMatchesPerNodeFormulasWithInterfaceAndDamping) {
   grid_update_case(true, 0.7);
 }

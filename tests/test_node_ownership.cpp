@@ -149,6 +149,31 @@ TEST(NodeOwnership, GridUpdateAndVelocitiesBitwiseWhateverTheSplit) {
   }
 }
 
+TEST(NodeOwnership, MomentumVelocitiesBitwiseWhateverTheSplit) {
+  // vel = p/m alone (MUSL's second transfer): a vectorised loop whose
+  // remainder moves with the split, so every cut must give the same bits.
+  const std::array<int, 3> dims{300, 170, 1};
+  auto run = [&](int threads, std::vector<std::size_t> split, UpdateGrid& g) {
+    const int saved = omp_get_max_threads();
+    omp_set_num_threads(threads);
+    NodeOwnership own;
+    own.split = std::move(split);
+    mmpm::grid_momentum_velocities(g.G, g.V, 1e-12, own);
+    omp_set_num_threads(saved);
+  };
+  UpdateGrid ref(dims);
+  run(1, {}, ref);
+  const std::size_t n = ref.nodes;
+  for (const auto& split : std::vector<std::vector<std::size_t>>{
+           {}, {0, 1, n}, {0, 4096 * 5 + 17, n}, {0, n, n}, {0, 0, n}, {0, 3, n}}) {
+    UpdateGrid g(dims);
+    run(2, split, g);
+    for (auto [a, b] : {std::pair{&ref.v0, &g.v0}, {&ref.v1, &g.v1}})
+      EXPECT_EQ(std::memcmp(a->data(), b->data(), a->size() * sizeof(double)), 0)
+          << "split at " << (split.empty() ? 0 : split[1]);
+  }
+}
+
 TEST(NodeOwnership, ZeroOwnedClearsEveryFieldOfEveryNode) {
   const std::size_t nodes = 20000;
   std::vector<double> a(3 * nodes, 1.0), b(3 * nodes, 2.0);

@@ -514,13 +514,7 @@ void Stepper<D, Shape, Real>::finish_velocities(bool with_dvel) {
   if (with_dvel) {
     grid_velocities(G_, GV_, mass_threshold_, own_);
   } else {
-#pragma omp parallel if (G_.nodes * std::size_t(G_.fields) >= kParallelMin)
-    for_own_nodes(own_, G_.nodes, G_.fields, [&](std::size_t b, std::size_t e) {
-      for (std::size_t i = b; i < e; ++i) {
-        const Real m = G_.m[i];
-        for (int d = 0; d < D; ++d) GV_.vel[d][i] = m > mass_threshold_ ? G_.p[d][i] / m : Real(0);
-      }
-    });
+    grid_momentum_velocities(G_, GV_, mass_threshold_, own_);
   }
   apply_boundaries(with_dvel);
 }
