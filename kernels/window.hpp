@@ -41,12 +41,20 @@
 
 namespace mmpm {
 
+template <class F, int... u>
+[[gnu::always_inline]] inline void static_for_each(F& f, std::integer_sequence<int, u...>) {
+  (f(std::integral_constant<int, u>{}), ...);
+}
+
+// f(integral_constant<int, u>) for u = 0 .. N - 1, unrolled. A function,
+// not a lambda over the index pack: GCC left such a lambda out of line in
+// the 3D gather (its attributes cannot be forced), and the gather's sums
+// then lived in memory, each unit's multiply-add waiting for the last
+// one's store (docs/performance.md "Unit loops kept inline"). The bodies
+// passed in are marked always_inline for the same reason.
 template <int N, class F>
 [[gnu::always_inline]] inline void static_for(F&& f) {
-  [&]<int... u>(std::integer_sequence<int, u...>) {
-    (f(std::integral_constant<int, u>{}), ...);
-  }
-  (std::make_integer_sequence<int, N>{});
+  static_for_each(f, std::make_integer_sequence<int, N>{});
 }
 
 template <int D, class Shape, class Real>
@@ -100,7 +108,7 @@ struct Window {
   template <int u>
   static void add(Real* a, const Offsets& off, const V& v) {
     const V sum = load<u>(a, off) + v;
-    static_for<RU>([&](auto k) {
+    static_for<RU>([&](auto k) __attribute__((always_inline)) {
       lanes_store(a + off[std::size_t(u * RU + k)], row_of<k>(sum, std::make_index_sequence<W>{}));
     });
   }
@@ -194,8 +202,7 @@ class WindowBuilder {
   // [0, n - 1), uGIMP and quadratic [1/2, n - 3/2) (stencil base
   // floor(xi - 1/2)), cubic [1, n - 2).
   static constexpr Real kLoXi = Shape::W == 2 ? Real(0) : (Shape::S == 3 ? Real(0.5) : Real(1));
-  static constexpr Real kHiMargin =
-      Shape::W == 2 ? Real(1) : (Shape::S == 3 ? Real(1.5) : Real(2));
+  static constexpr Real kHiMargin = Shape::W == 2 ? Real(1) : (Shape::S == 3 ? Real(1.5) : Real(2));
 
   explicit WindowBuilder(const GridView<D, Real>& G) {
     for (int d = 0; d < D; ++d) {
@@ -311,7 +318,7 @@ class WindowBuilder {
       // selects on constant masks. (A runtime loop over the parts, or
       // joining them with a shuffle, made GCC 12.2's SLP vectoriser crash on
       // tests/test_p2g.cpp, and the join measured slower.)
-      static_for<kParts>([&](auto hc) {
+      static_for<kParts>([&](auto hc) __attribute__((always_inline)) {
         constexpr int h = decltype(hc)::value;
         Part pw, pdw;
         Shape::lanes(per_direction(r, h) + offsets_lanes[h], per_direction(l, h), pw, pdw);

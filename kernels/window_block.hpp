@@ -110,7 +110,7 @@ struct WindowBlock {
   void flush(const GridView<D, Real>& G, const typename Win::Offsets& off) {
     if (current == SIZE_MAX) return;
     const std::size_t b = current;
-    static_for<U>([&](auto uc) {
+    static_for<U>([&](auto uc) __attribute__((always_inline)) {
       constexpr int u = decltype(uc)::value, wu = U0 + u;  // block unit, window unit
       if constexpr (kMass) Win::template add<wu>(G.m + b, off, am[u]);
       for (int d = 0; d < D; ++d) {
@@ -137,7 +137,7 @@ struct WindowBlock {
   template <int U0 = 0>
   void accumulate(const Win& win, const ScatterSource<D, Real>& q) {
     const V X = win.X(), GXl = win.GX();
-    static_for<U>([&](auto uc) {
+    static_for<U>([&](auto uc) __attribute__((always_inline)) {
       constexpr int u = decltype(uc)::value, wu = U0 + u;  // block unit, window unit
       const V Yu = win.template Y<wu>();
       const V s = X * Yu;
@@ -220,7 +220,7 @@ class GroupedScatter {
       while (j < count && base[j] == base[i]) ++j;
       const bool resume = i == 0 && carrying_;
       const bool cut = j == count && more;
-      static_for<kGroups>([&](auto gc) {
+      static_for<kGroups>([&](auto gc) __attribute__((always_inline)) {
         constexpr int g = decltype(gc)::value;
         Block block;  // a local the compiler keeps in registers
         if (resume) block = carried_[g];
@@ -239,7 +239,7 @@ class GroupedScatter {
   // Writes out a carried run (call once the particles are done).
   void finish() {
     if (!carrying_) return;
-    static_for<kGroups>([&](auto gc) {
+    static_for<kGroups>([&](auto gc) __attribute__((always_inline)) {
       constexpr int g = decltype(gc)::value;
       carried_[g].template flush<g * UG>(G_, off_);
       carried_[g].clear();
