@@ -86,10 +86,11 @@ struct G2PGather {
   // The grid velocities (and changes) of one window, its rows joined into
   // units: loaded when a particle's window differs from the one held, and
   // reused by the rest of its run (the particles of one cell and field are
-  // consecutive). Why: per particle, the loads and row joins of the window
-  // were a third of the gather's instructions (3D uGIMP double: 6 arrays x
-  // 8 units, each two loads and a shuffle), repeated for every particle of
-  // the cell. Same values, same sums: bitwise the per-particle loads.
+  // consecutive). Why: the loads and row joins of a window (3D uGIMP
+  // double, MUSL's first pass: 6 arrays x 8 units, each two loads and a
+  // shuffle) were repeated for every particle of the cell. Same values,
+  // same sums: bitwise the per-particle loads (docs/performance.md "Unit
+  // loops kept inline; a window's grid values held for its run").
   struct WindowValues {
     std::size_t base = SIZE_MAX;
     typename Win::V vel[D][Win::units] = {}, dvel[D][Win::units] = {};
