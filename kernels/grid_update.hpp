@@ -157,15 +157,18 @@ double grid_update(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
   return loss;
 }
 
-// vel = p/m, dvel += vel (completing v_new - v_old), after pass B; nodes
-// with a sliver of mass keep vel = 0 and the increment grid_update gave them.
-template <int D, class Real>
-void grid_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V, Real thr,
-                     const NodeOwnership& own = {}) {
+namespace detail {
+
+// The node loop of grid_velocities (CompleteDvel) and
+// grid_momentum_velocities: selects instead of a branch per node, through
+// restrict pointers, so the compiler vectorises it (the branchy loops ran
+// scalar). Every node computes its quotient (m = 0 gives 0/0 or inf, which
+// the select drops).
+template <bool CompleteDvel, int D, class Real>
+void node_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V, Real thr,
+                     const NodeOwnership& own) {
 #pragma omp parallel if (G.nodes * std::size_t(G.fields) >= kParallelMin)
   for_own_nodes(own, G.nodes, G.fields, [&](std::size_t b, std::size_t e) {
-    // Selects instead of a branch per node, through restrict pointers: a
-    // loop the compiler vectorises (the branchy one ran scalar).
     const Real* __restrict m_ = G.m;
     const Real* __restrict p_[D];
     Real* __restrict vel_[D];
@@ -175,41 +178,43 @@ void grid_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
     for (std::size_t i = b; i < e; ++i) {
       const Real m = m_[i];
       const bool heavy = m > thr;
-      const Real inv_m = Real(1) / m;
-      for (int d = 0; d < D; ++d) {
-        // dvel + p/m as an explicit fma (see update_deformable).
-        const Real v = p_[d][i] * inv_m, dv = std::fma(p_[d][i], inv_m, dv_[d][i]);
-        vel_[d][i] = heavy ? v : Real(0);
-        dv_[d][i] = heavy ? dv : dv_[d][i];  // slivers: set by grid_update
+      if constexpr (CompleteDvel) {
+        const Real inv_m = Real(1) / m;
+        for (int d = 0; d < D; ++d) {
+          // dvel + p/m as an explicit fma (see update_deformable).
+          const Real v = p_[d][i] * inv_m, dv = std::fma(p_[d][i], inv_m, dv_[d][i]);
+          vel_[d][i] = heavy ? v : Real(0);
+          dv_[d][i] = heavy ? dv : dv_[d][i];  // slivers: set by grid_update
+        }
+      } else {
+        for (int d = 0; d < D; ++d) {
+          const Real v = p_[d][i] / m;
+          vel_[d][i] = heavy ? v : Real(0);
+        }
       }
     }
   });
 }
 
-// vel = p/m alone (no dvel): the velocities of re-extrapolated momenta
-// (MUSL's second transfer, USF's first); slivers get vel = 0. The division
-// runs for every node and the select keeps it where m > thr (m = 0 gives
-// 0/0, dropped): a loop the compiler vectorises, where the branchy one ran
-// scalar, with the bits of p/m unchanged.
+}  // namespace detail
+
+// vel = p/m, dvel += vel (completing v_new - v_old), after pass B; nodes
+// with a sliver of mass keep vel = 0 and the increment grid_update gave them.
+template <int D, class Real>
+void grid_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V, Real thr,
+                     const NodeOwnership& own = {}) {
+  detail::node_velocities<true>(G, V, thr, own);
+}
+
+// vel = p/m alone (dvel untouched): the velocities of re-extrapolated
+// momenta (MUSL's second transfer, USF's first); slivers get vel = 0. The
+// quotient is p/m as the Stepper's scalar loop computed it (bitwise), in a
+// loop that now vectorises (docs/performance.md "Loops the compiler
+// vectorises").
 template <int D, class Real>
 void grid_momentum_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V, Real thr,
                               const NodeOwnership& own = {}) {
-#pragma omp parallel if (G.nodes * std::size_t(G.fields) >= kParallelMin)
-  for_own_nodes(own, G.nodes, G.fields, [&](std::size_t b, std::size_t e) {
-    const Real* __restrict m_ = G.m;
-    const Real* __restrict p_[D];
-    Real* __restrict vel_[D];
-    for (int d = 0; d < D; ++d) p_[d] = G.p[d], vel_[d] = V.vel[d];
-#pragma GCC ivdep
-    for (std::size_t i = b; i < e; ++i) {
-      const Real m = m_[i];
-      const bool heavy = m > thr;
-      for (int d = 0; d < D; ++d) {
-        const Real v = p_[d][i] / m;
-        vel_[d][i] = heavy ? v : Real(0);
-      }
-    }
-  });
+  detail::node_velocities<false>(G, V, thr, own);
 }
 
 }  // namespace mmpm
