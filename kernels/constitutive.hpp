@@ -51,15 +51,25 @@ struct Moduli {
   Real lam, mu2;
 };
 
-// The small-strain isotropic update (plane strain in 2D) of particles
-// [first, last), the moduli of particle p from moduli(p): the loop shared
-// by IsotropicPoint::range (one material) and IsotropicByMaterial (a
-// lookup by material). Restrict pointers, no branch: it vectorises. Same
-// arithmetic as IsotropicPoint::operator().
-template <int D, class Real, class ModuliOf>
+// 2D plane stress: E/(1 - nu^2), nu, and nu/(1 - nu) for the thickness
+// strain's share of the volume change.
+template <class Real>
+struct PlaneStress {
+  Real Ep, nu, zz;
+};
+
+// The small-strain isotropic update of particles [first, last), the
+// moduli of particle p from moduli(p): the loop shared by
+// IsotropicPoint::range (one material; plane stress through `ps` when
+// PlaneStressLaw) and IsotropicByMaterial (a lookup by material). Restrict
+// pointers, no branch: it vectorises. Same arithmetic as
+// IsotropicPoint::operator().
+template <int D, class Real, bool PlaneStressLaw = false, class ModuliOf>
 [[gnu::always_inline]] inline void isotropic_strain_loop(const ParticleView<D, Real>& P, Real dt,
                                                          std::size_t first, std::size_t last,
-                                                         const ModuliOf& moduli) {
+                                                         const ModuliOf& moduli,
+                                                         const PlaneStress<Real>& ps = {}) {
+  static_assert(D == 2 || !PlaneStressLaw, "plane stress is a 2D law");
   Real* __restrict V = P.V;
   if constexpr (D == 2) {
     const Real* __restrict L0 = P.L[0];
@@ -76,12 +86,19 @@ template <int D, class Real, class ModuliOf>
       const Real exx = dt * L0[p], eyy = dt * L3[p];
       const Real exy = Real(0.5) * dt * (L1[p] + L2[p]);
       const Real a = Real(1) + exx, b = dt * L1[p], c = dt * L2[p], d = Real(1) + eyy;
-      const Real tr = k.lam * (exx + eyy);
-      s0[p] += tr + k.mu2 * exx;
-      s1[p] += tr + k.mu2 * eyy;
-      s2[p] += k.mu2 * exy;
-      s3[p] += tr;
-      V[p] *= a * d - b * c;
+      if constexpr (PlaneStressLaw) {
+        s0[p] += ps.Ep * (exx + ps.nu * eyy);
+        s1[p] += ps.Ep * (eyy + ps.nu * exx);
+        s2[p] += k.mu2 * exy;
+        V[p] *= (a * d - b * c) * (Real(1) - ps.zz * (exx + eyy));
+      } else {
+        const Real tr = k.lam * (exx + eyy);
+        s0[p] += tr + k.mu2 * exx;
+        s1[p] += tr + k.mu2 * eyy;
+        s2[p] += k.mu2 * exy;
+        s3[p] += tr;
+        V[p] *= a * d - b * c;
+      }
     }
   } else {
     const Real* __restrict L[9];
@@ -161,38 +178,15 @@ struct IsotropicPoint {
   // with the plane-stress branch hoisted (docs/performance.md "Loops the
   // compiler vectorises").
   void range(const ParticleView<D, Real>& P, std::size_t first, std::size_t last) const {
+    const auto moduli = [this](std::size_t) { return Moduli<Real>{lam, mu2}; };
     if constexpr (D == 2) {
       if (pstress) {
-        plane_stress_range(P, first, last);
+        isotropic_strain_loop<D, Real, true>(P, dt, first, last, moduli,
+                                             PlaneStress<Real>{Ep, nu, nu / (Real(1) - nu)});
         return;
       }
     }
-    isotropic_strain_loop(P, dt, first, last,
-                          [this](std::size_t) { return Moduli<Real>{lam, mu2}; });
-  }
-
- private:
-  void plane_stress_range(const ParticleView<D, Real>& P, std::size_t first,
-                          std::size_t last) const {
-    Real* __restrict V = P.V;
-    const Real* __restrict L0 = P.L[0];
-    const Real* __restrict L1 = P.L[1];
-    const Real* __restrict L2 = P.L[2];
-    const Real* __restrict L3 = P.L[3];
-    Real* __restrict s0 = P.s[0];
-    Real* __restrict s1 = P.s[1];
-    Real* __restrict s2 = P.s[2];
-    const Real zz = nu / (Real(1) - nu);
-#pragma GCC ivdep
-    for (std::size_t p = first; p < last; ++p) {
-      const Real exx = dt * L0[p], eyy = dt * L3[p];
-      const Real exy = Real(0.5) * dt * (L1[p] + L2[p]);
-      const Real a = Real(1) + exx, b = dt * L1[p], c = dt * L2[p], d = Real(1) + eyy;
-      s0[p] += Ep * (exx + nu * eyy);
-      s1[p] += Ep * (eyy + nu * exx);
-      s2[p] += mu2 * exy;
-      V[p] *= (a * d - b * c) * (Real(1) - zz * (exx + eyy));
-    }
+    isotropic_strain_loop(P, dt, first, last, moduli);
   }
 };
 
@@ -208,8 +202,9 @@ struct IsotropicByMaterial {
 
   void range(const ParticleView<D, Real>& P, std::size_t first, std::size_t last) const {
     const std::uint8_t* __restrict mat = P.mat;
-    isotropic_strain_loop(P, dt, first, last,
-                          [&](std::size_t p) { return Moduli<Real>{lam[mat[p]], mu2[mat[p]]}; });
+    isotropic_strain_loop(P, dt, first, last, [&](std::size_t p) {
+      return Moduli<Real>{lam[mat[p]], mu2[mat[p]]};
+    });
   }
 };
 
