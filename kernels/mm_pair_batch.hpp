@@ -4,9 +4,11 @@
 // joined by one interaction. Node by node, each costs a chain of square
 // roots and divisions (normal, tangent, h⊥, area, force limit) plus a dozen
 // scattered grid loads; in lanes across nodes the work of different nodes
-// overlaps (independent chains, array-by-array gathers), and where GCC
-// vectorises a lane loop (pass B's, for most laws; not pass A's, see
-// docs/multimaterial.md) it runs in SIMD registers.
+// overlaps (independent chains, array-by-array gathers), and the lane loops
+// run in SIMD registers: GCC vectorises both passes for every law (but
+// Coulomb friction in 3D pass A). Pass A's loop is written for
+// that: selects between Reals only, no run-time flag inside
+// (docs/multimaterial.md "Pass A in SIMD lanes").
 //
 // The lane code does, per node, the operations of interact_pass_a /
 // interact_pass_b_saved (kernels/multimaterial.hpp) for a deformable pair
@@ -53,6 +55,9 @@ struct PairBatch {
   alignas(64) Real n[D][kLanes];
   alignas(64) Real dn[kLanes];
   alignas(64) unsigned char stick[kLanes];
+  // Pass A's stick bits + 8 × limited count as a Real: the lane loop then
+  // writes only Reals (see pass_a_lanes), and a scalar loop unpacks it.
+  alignas(64) Real flags[kLanes];
 
   // Outputs for field_a (field_b gets the negatives).
   alignas(64) Real change[D][kLanes];
@@ -92,23 +97,34 @@ void gather_batch(const GridView<D, Real>& grid, const BatchNeeds& needs, PairBa
     }
 }
 
-// normalized_or_zero without the early return.
+// normalized_or_zero without the early return, for finite u (a non-finite
+// u gives a non-finite result where normalized_or_zero gives zero; callers
+// test the result with finite_nonzero). u times a selected scale, not a
+// select of u / |u|: GCC 12 threaded the select's condition into the
+// callers' tests of the result, as selects between booleans that its
+// vectoriser rejects.
 template <int D, class Real>
 inline VecD<D, Real> unit_or_zero(const VecD<D, Real>& u) {
   const Real len = std::sqrt(dot<D, Real>(u, u));
   const bool ok = (len > 0) & std::isfinite(len);
-  const Real inv = Real(1) / len;
+  const Real scale = ok ? Real(1) / len : Real(0);
   VecD<D, Real> r;
-  for (int d = 0; d < D; ++d) r[d] = ok ? u[d] * inv : Real(0);
+  for (int d = 0; d < D; ++d) r[d] = u[d] * scale;
   return r;
 }
 
-// directional_stick_change with selects.
+// n is nonzero and finite (a usable unit_or_zero result).
 template <int D, class Real>
-inline VecD<D, Real> stick_change_lane(unsigned char stick, const VecD<D, Real>& dp,
+inline bool finite_nonzero(const VecD<D, Real>& n) {
+  const Real nn = dot<D, Real>(n, n);
+  return (nn != Real(0)) & std::isfinite(nn);
+}
+
+// directional_stick_change with selects: the normal and/or tangential
+// part of dp, as the directions stick.
+template <int D, class Real>
+inline VecD<D, Real> stick_change_lane(bool normal, bool tangential, const VecD<D, Real>& dp,
                                        const VecD<D, Real>& n) {
-  const bool normal = (stick & (kStickNormal | kStickBoth)) != 0;
-  const bool tangential = (stick & (kStickTangential | kStickBoth)) != 0;
   const Real dn = dot<D, Real>(dp, n);
   VecD<D, Real> r;
   for (int d = 0; d < D; ++d) {
@@ -154,10 +170,12 @@ inline VecD<D, Real> lane(const Real* v, int i) {
 }
 
 // Pass A on the lanes of B: the normal by method M, the pair's law L
-// (Law::interface: the imperfect interface with explicit integration).
-template <NormalMethod M, Law L, int D, class Real>
+// (Law::interface: the imperfect interface with explicit integration),
+// with Δf in the force limit when UseDf (a template parameter: a select on
+// a run-time flag kept GCC from vectorising the loop).
+template <NormalMethod M, Law L, bool UseDf, int D, class Real>
 void pass_a_lanes(PairBatch<D, Real>& B, Real sign, const std::array<Real, 3>& h, Real dt,
-                  Real thickness, bool use_force_difference) {
+                  Real thickness) {
   const PairParams<Real>& pp = *B.params;
   const Real omega_min = pp.omega_min, friction = pp.friction;
   const bool position_method = pp.separation == Separation::position;
@@ -195,7 +213,7 @@ void pass_a_lanes(PairBatch<D, Real>& B, Real sign, const std::array<Real, 3>& h
     // & and | rather than && and || on lane conditions: short-circuits are
     // branches, which keep a loop from being if-converted and vectorised.
     const bool screened = va + vb < omega_min;
-    const bool valid = !screened & (dot<D, Real>(n, n) != Real(0));
+    const bool valid = !screened & finite_nonzero<D, Real>(n);
 
     // (P-7, P-8), (P-11), (P-12), (P-15), (P-22), (P-14).
     const VecD<D, Real> dp = momentum_change_to_center_of_mass<D, Real>(ma, pa, mb, pb, false);
@@ -212,15 +230,15 @@ void pass_a_lanes(PairBatch<D, Real>& B, Real sign, const std::array<Real, 3>& h
       if constexpr (D == 2) {
         perpendicular = {-n[1], n[0]};
       } else {  // tangent_or_perpendicular's axis least aligned with n
+        // Selects between Reals only (see the flags below).
         const Real a0 = std::abs(n[0]), a1 = std::abs(n[1]), a2 = std::abs(n[2]);
-        const bool axis1 = a1 < a0;
-        const Real best01 = axis1 ? a1 : a0;
-        const bool axis2 = a2 < best01;
-        const Real n_axis = axis2 ? n[2] : axis1 ? n[1] : n[0];
+        const Real best01 = a1 < a0 ? a1 : a0;
+        const Real e1 = a1 < a0 ? Real(1) : Real(0);
+        const Real n_axis = a2 < best01 ? n[2] : a1 < a0 ? n[1] : n[0];
         VecD<D, Real> e;
-        e[0] = !axis2 && !axis1 ? Real(1) : Real(0);
-        e[1] = !axis2 && axis1 ? Real(1) : Real(0);
-        e[2] = axis2 ? Real(1) : Real(0);
+        e[0] = a2 < best01 ? Real(0) : Real(1) - e1;
+        e[1] = a2 < best01 ? Real(0) : e1;
+        e[2] = a2 < best01 ? Real(1) : Real(0);
         perpendicular = unit_or_zero<D, Real>(add_scaled<D, Real>(e, n, -n_axis));
       }
       for (int d = 0; d < D; ++d) t[d] = delta_t > 0 ? opening_t[d] * inv_len : perpendicular[d];
@@ -233,8 +251,7 @@ void pass_a_lanes(PairBatch<D, Real>& B, Real sign, const std::array<Real, 3>& h
 
     VecD<D, Real> change, force{};
     [[maybe_unused]] double energy = 0;
-    [[maybe_unused]] unsigned char stick = 0;
-    [[maybe_unused]] int limited = 0;
+    [[maybe_unused]] Real flags = 0;
     if constexpr (L != Law::interface) {
       // in_contact (P-9, P-12, P-14), with & on the masks.
       change = contact_change_lane<L, D, Real>((dp_n < 0) & (dn < 0), friction, dp, n);
@@ -248,7 +265,7 @@ void pass_a_lanes(PairBatch<D, Real>& B, Real sign, const std::array<Real, 3>& h
       const Real area = contact_area<D, Real>(va, vb, hp, thickness);
       const Real m_red = reduced_mass(ma, mb, false);
       VecD<D, Real> df{};
-      if (use_force_difference)
+      if constexpr (UseDf)
         df = force_difference<D, Real>(ma, lane<D, Real>(B.f[0][0], i), mb,
                                        lane<D, Real>(B.f[1][0], i), false);
       const Real fn = Tn * area, ft = Tt * area;
@@ -256,23 +273,33 @@ void pass_a_lanes(PairBatch<D, Real>& B, Real sign, const std::array<Real, 3>& h
           exceeds_force_limit(fn, force_limit_component(m_red, dt, dn, dp_n, dot<D, Real>(df, n)));
       const bool over_t = exceeds_force_limit(
           ft, force_limit_component(m_red, dt, delta_t, dot<D, Real>(dp, t), dot<D, Real>(df, t)));
-      const bool limit_n = !perfect_n & force_limit & over_n;
-      const bool limit_t = !perfect_t & force_limit & over_t;
-      const bool stick_n = perfect_n | limit_n, stick_t = perfect_t | limit_t;
-      stick = (unsigned char)((stick_n ? kStickNormal : 0) | (stick_t ? kStickTangential : 0) |
-                              (stick_n & stick_t ? kStickBoth : 0));
-      limited = int(limit_n) + int(limit_t);
-      change = stick_change_lane<D, Real>(stick, dp, n);
-      const Real on = stick_n ? Real(0) : fn, ot = stick_t ? Real(0) : ft;
+      // The direction flags as 0/1 Reals: boolean algebra over these lane
+      // conditions became selects between booleans in GCC 12, which its
+      // vectoriser rejects; products and sums of Reals do not.
+      const Real one = 1, none = 0, limiting = force_limit ? one : none;
+      const Real pn = perfect_n ? one : none, pt = perfect_t ? one : none;
+      const Real ln = (one - pn) * limiting * (over_n ? one : none);
+      const Real lt = (one - pt) * limiting * (over_t ? one : none);
+      const Real sn = pn + ln, st = pt + lt;  // stick: perfect or limited (exclusive)
+      flags = sn * Real(kStickNormal) + st * Real(kStickTangential) + sn * st * Real(kStickBoth) +
+              Real(8) * (ln + lt);
+      change = stick_change_lane<D, Real>(sn != none, st != none, dp, n);
+      const Real on = sn != none ? Real(0) : fn, ot = st != none ? Real(0) : ft;
       for (int d = 0; d < D; ++d) force[d] = on * n[d] + ot * t[d];
-      energy = double(stick_n ? Real(0) : en * area) + double(stick_t ? Real(0) : et * area);
+      energy = double(sn != none ? Real(0) : en * area) + double(st != none ? Real(0) : et * area);
     }
     for (int d = 0; d < D; ++d) B.change[d][i] = valid ? change[d] : Real(0);
     if constexpr (L == Law::interface) {
       for (int d = 0; d < D; ++d) B.force[d][i] = valid ? force[d] : Real(0);
       B.energy[i] = valid ? energy : 0.0;
-      B.stick[i] = valid ? stick : (unsigned char)0;
-      B.limited[i] = valid ? limited : 0;
+      B.flags[i] = valid ? flags : Real(0);
+    }
+  }
+  if constexpr (L == Law::interface) {
+    for (int i = 0; i < count; ++i) {
+      const int code = int(B.flags[i]);
+      B.stick[i] = (unsigned char)(code & 7);
+      B.limited[i] = code >> 3;
     }
   }
   if constexpr (L != Law::interface) {  // contact laws: no force, energy or flags
@@ -299,7 +326,9 @@ void pass_b_lanes(PairBatch<D, Real>& B) {
     const bool has_normal = dot<D, Real>(n, n) != Real(0);
     VecD<D, Real> change;
     if constexpr (L == Law::interface) {
-      change = stick_change_lane<D, Real>(B.stick[i], dp, n);
+      const unsigned char s = B.stick[i];
+      change = stick_change_lane<D, Real>((s & (kStickNormal | kStickBoth)) != 0,
+                                          (s & (kStickTangential | kStickBoth)) != 0, dp, n);
     } else {
       const bool contact = (dot<D, Real>(dp, n) < 0) & (B.dn[i] < 0);  // in_contact
       change = contact_change_lane<L, D, Real>(contact, friction, dp, n);
@@ -313,13 +342,15 @@ void pass_a_lanes_of_law(PairBatch<D, Real>& B, Real sign, const std::array<Real
                          Real thickness, bool use_force_difference) {
   switch (B.params->law) {
     case Law::stick:
-      return pass_a_lanes<M, Law::stick>(B, sign, h, dt, thickness, use_force_difference);
+      return pass_a_lanes<M, Law::stick, false>(B, sign, h, dt, thickness);
     case Law::frictionless:
-      return pass_a_lanes<M, Law::frictionless>(B, sign, h, dt, thickness, use_force_difference);
+      return pass_a_lanes<M, Law::frictionless, false>(B, sign, h, dt, thickness);
     case Law::friction:
-      return pass_a_lanes<M, Law::friction>(B, sign, h, dt, thickness, use_force_difference);
+      return pass_a_lanes<M, Law::friction, false>(B, sign, h, dt, thickness);
     default:
-      return pass_a_lanes<M, Law::interface>(B, sign, h, dt, thickness, use_force_difference);
+      if (use_force_difference)
+        return pass_a_lanes<M, Law::interface, true>(B, sign, h, dt, thickness);
+      return pass_a_lanes<M, Law::interface, false>(B, sign, h, dt, thickness);
   }
 }
 
