@@ -198,6 +198,66 @@ TEST(MultimaterialPairBatch, TwoFieldsEveryOptionMatchesPerNode2DFloat) {
   check_two_fields<2, float>();
 }
 
+// Nodes without a usable normal: both fields' domain gradients infinite,
+// NaN or zero at every third listed node (mvg and avg normals). The
+// per-node path skips such a node (normalized_or_zero gives zero). The lanes
+// compute the normal as u times a selected scale, which is non-finite for a
+// non-finite u, and must skip the node as well: finite_nonzero rejects it
+// (kernels/mm_pair_batch.hpp). Expected: the per-node results, no interface
+// force at those nodes, and every momentum finite. Dropping the finiteness
+// test lets the NaN through to p and fi.
+template <int D, class Real>
+void check_unusable_normals() {
+  const Real bad[3] = {std::numeric_limits<Real>::infinity(),
+                       std::numeric_limits<Real>::quiet_NaN(), Real(0)};
+  for (NormalMethod normal : {NormalMethod::mvg, NormalMethod::avg}) {
+    PairParams<Real> pp;
+    pp.law = Law::interface;
+    pp.normal_method = normal;
+    pp.Dn = Real(5e3);
+    pp.Dt = Real(2e3);
+    TestGrid<D, Real> batched(dims_of(D), 2), per_node(dims_of(D), 2);
+    fill_random(batched, 11);
+    fill_random(per_node, 11);
+    TestSetup<D, Real> s1(2, Real(1e-3)), s2(2, Real(1e-3));
+    s1.connect(0, 1, pp);
+    s2.connect(0, 1, pp);
+    std::vector<std::uint32_t> list;
+    mmpm::find_multimaterial_nodes(batched.view, s1.config().mass_threshold, list);
+    ASSERT_GT(list.size(), 30u);
+    std::vector<std::uint32_t> poisoned;
+    for (std::size_t k = 0; k < list.size(); k += 3) {
+      const Real v = bad[(k / 3) % 3];
+      for (TestGrid<D, Real>* grid : {&batched, &per_node})
+        for (int field = 0; field < 2; ++field)
+          for (int d = 0; d < D; ++d) grid->g[d][grid->at(field, list[k])] = v;
+      poisoned.push_back(list[k]);
+    }
+    const Outcome o1 = run(batched, s1, true);
+    const Outcome o2 = run(per_node, s2, false);
+    expect_same("unusable normals, normal " + std::to_string(int(normal)), batched, o1, per_node,
+                o2, force_tolerance<Real>(5e3));
+    for (const std::uint32_t node : poisoned)
+      for (int field = 0; field < 2; ++field)
+        for (int d = 0; d < D; ++d)
+          EXPECT_EQ(batched.fi[d][batched.at(field, node)], Real(0)) << "node " << node;
+    for (int d = 0; d < D; ++d)
+      for (std::size_t i = 0; i < batched.p[d].size(); ++i)
+        ASSERT_TRUE(std::isfinite(batched.p[d][i])) << "momentum " << d << " entry " << i;
+    long interacting = 0;  // the other nodes did interact
+    for (std::size_t k = 0; k < list.size(); ++k)
+      if (k % 3 != 0) interacting += batched.fi[0][batched.at(0, list[k])] != Real(0);
+    EXPECT_GT(interacting, long(list.size() / 3));
+  }
+}
+
+TEST(MultimaterialPairBatch, UnusableNormalsSkippedAsPerNode2D) {
+  check_unusable_normals<2, double>();
+}
+TEST(MultimaterialPairBatch, UnusableNormalsSkippedAsPerNode3DFloat) {
+  check_unusable_normals<3, float>();
+}
+
 // Four fields, field 3 rigid, six pairs with different laws and normals, one
 // with the exact integration: chunks mix batched nodes (the first pair met),
 // nodes of other pairs, nodes with three or four fields and rigid partners.
