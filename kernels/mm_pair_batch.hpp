@@ -295,14 +295,13 @@ void pass_a_lanes(PairBatch<D, Real>& B, Real sign, const std::array<Real, 3>& h
       B.flags[i] = valid ? flags : Real(0);
     }
   }
-  if constexpr (L == Law::interface) {
+  if constexpr (L == Law::interface) {  // unpack the flags: stick bits + 8 × limited
     for (int i = 0; i < count; ++i) {
       const int code = int(B.flags[i]);
       B.stick[i] = (unsigned char)(code & 7);
       B.limited[i] = code >> 3;
     }
-  }
-  if constexpr (L != Law::interface) {  // contact laws: no force, energy or flags
+  } else {  // contact laws: no force, energy or flags
     for (int i = 0; i < count; ++i) {
       for (int d = 0; d < D; ++d) B.force[d][i] = Real(0);
       B.energy[i] = 0;
