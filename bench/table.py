@@ -37,7 +37,7 @@ def parse_name(name):
 
 # Headline times: the minimum over the samples (passes; the least disturbed run
 # on a shared machine). Every other counter (stage breakdowns, node counts): the median.
-PRIMARY = {"ns_per_particle", "ns_per_mm_node"}
+PRIMARY = {"ns_per_particle", "ns_per_mm_node", "ns_per_node"}
 
 
 def merge(out_path, pass_paths, loads_path=None):
@@ -278,6 +278,42 @@ def kernel_section(R):
             if v1 is not None or v2 is not None:
                 rows.append(["constitutive", dim + "D", "–", real, fmt(v1), fmt(v2), ratio(v1, v2), fmt(gb),
                              "–", "–"])
+    out.append(table(header, rows))
+    return out
+
+
+def grid_section(R):
+    ns = "ns_per_node"
+    out = ["## 8. Grid node loops alone (ns/node)", "",
+           "bench_grid.cpp: the single-material MUSL step's node loops (kernels/grid_update.hpp) on "
+           "one field, 2D 255² and 3D 41³ nodes, each thread on an even share it touched first. "
+           "update = grid_update with the velocities (reads m, p, f; writes p, vel, dvel), "
+           "velocities = grid_momentum_velocities (reads m, p; writes vel), triad = a = b + s c over "
+           "three node arrays: the machine's own 2-thread gain for a loop of this length, in the "
+           "same run. warm = the loop repeated (each thread's nodes in its caches); evicted = every "
+           "thread reads 64 MiB before each call (the grid comes from memory). GB/s count each "
+           "write twice, as the triad does. The in-step grid stage (§3 stage columns) sits between "
+           "the two states.", ""]
+    header = ["dim", "real", "kernel", "warm 1t", "warm 2t", "speed-up", "GB/s (warm 1t)",
+              "evicted 1t", "evicted 2t", "speed-up", "GB/s (evicted 1t)"]
+    rows = []
+    for dim in ("2", "3"):
+        for real in ("double", "float"):
+            for kernel in ("update", "velocities", "triad"):
+                v = {}
+                for cache in ("warm", "evicted"):
+                    for t in (1, 2):
+                        v[cache, t] = R.value("grid", ns, dim=dim, real=real, kernel=kernel,
+                                              cache=cache, threads=t)
+                if all(x is None for x in v.values()):
+                    continue
+                gw = R.value("grid", "GBps", dim=dim, real=real, kernel=kernel, cache="warm", threads=1)
+                ge = R.value("grid", "GBps", dim=dim, real=real, kernel=kernel, cache="evicted",
+                             threads=1)
+                rows.append([dim + "D", real, kernel, fmt(v["warm", 1], 2), fmt(v["warm", 2], 2),
+                             ratio(v["warm", 1], v["warm", 2]), fmt(gw),
+                             fmt(v["evicted", 1], 2), fmt(v["evicted", 2], 2),
+                             ratio(v["evicted", 1], v["evicted", 2]), fmt(ge)])
     out.append(table(header, rows))
     return out
 
@@ -585,7 +621,7 @@ def main():
         lines += [f"- Note: {args.note}"]
     lines.append("")
     for section in (p2g_section, kernel_section, step_section, mm_section, unused_section,
-                    sort_section, scaling_section):
+                    sort_section, scaling_section, grid_section):
         lines += section(R)
         lines.append("")
     if errors:

@@ -1024,6 +1024,38 @@ TEST(MultimaterialNodes, FindsAscendingNodesWithTwoOrMoreFields) {
   omp_set_num_threads(saved);
 }
 
+TEST(MultimaterialNodes, FindsSparseNodesAtGroupEdges) {
+  // The listing passes over 64-node groups without a multimaterial node
+  // (kernels/multimaterial.hpp, any_two_or_more): one interface column, as in
+  // the two-layer scene, plus single nodes at the edges of groups and blocks
+  // and in the short last group (100 x 90 = 9000 nodes: 140 full groups and
+  // a group of 40), with one or three fields present elsewhere.
+  TestGrid<2, double> grid({100, 90, 1}, 3);
+  const std::size_t nodes = grid.view.nodes;
+  for (std::size_t i = 0; i < nodes; ++i) grid.m[grid.at(i % 3, i)] = 1.0;  // one field
+  std::vector<std::uint32_t> expected;
+  for (std::size_t i = 0; i < nodes; ++i) {
+    const bool column = i % 100 == 37;
+    const bool edge =
+        i == 63 || i == 64 || i == 4095 || i == 4096 || i == 8959 || i == 8960 || i == nodes - 1;
+    if (!column && !edge) continue;
+    grid.m[grid.at((i + 1) % 3, i)] = 1.0;                  // a second field
+    if (i % 2 == 0) grid.m[grid.at((i + 2) % 3, i)] = 1.0;  // and sometimes a third
+    expected.push_back(std::uint32_t(i));
+  }
+  std::vector<std::uint32_t> list;
+  mmpm::find_multimaterial_nodes(grid.view, 1e-9, list);
+  EXPECT_EQ(list, expected);
+  const int saved = omp_get_max_threads();
+  omp_set_num_threads(2);
+  mmpm::NodeOwnership own;
+  own.split = {0, 4160, nodes};
+  std::vector<std::uint32_t> owned;
+  mmpm::find_multimaterial_nodes(grid.view, 1e-9, owned, own);
+  EXPECT_EQ(owned, expected);
+  omp_set_num_threads(saved);
+}
+
 // ------------------------------------------------------------------ determinism
 
 template <int D, class Real>

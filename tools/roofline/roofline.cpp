@@ -13,7 +13,8 @@
 //    kernel's arithmetic (docs/performance.md derives the counts), and prints
 //    achieved GB/s and GFLOP/s next to the bound
 //    max(bytes / bandwidth, flops / peak) and the ratio time / bound.
-// Usage: mmpm_roofline [--threads N] [--steps K]
+// Usage: mmpm_roofline [--threads N] [--steps K] [--only TEXT]
+//   --only runs the cases whose label contains TEXT (e.g. "2D linear").
 #include <omp.h>
 
 #include <algorithm>
@@ -109,20 +110,31 @@ std::string block_scene(const Case& c) {
 
 int main(int argc, char** argv) {
   int threads = 1, steps = 20;
+  const char* only = nullptr;
   for (int i = 1; i + 1 < argc; ++i) {
+    if (!std::strcmp(argv[i], "--only")) only = argv[i + 1];
     if (!std::strcmp(argv[i], "--threads")) threads = std::atoi(argv[i + 1]);
     if (!std::strcmp(argv[i], "--steps")) steps = std::atoi(argv[i + 1]);
+  }
+  const Case cases[] = {{"2D linear double", 2, "linear", "double", 2},
+                        {"2D gimp double", 2, "gimp", "double", 3},
+                        {"2D gimp float", 2, "gimp", "float", 3},
+                        {"3D gimp double", 3, "gimp", "double", 3}};
+  bool any = false;
+  for (const Case& c : cases) any = any || !only || std::strstr(c.label, only);
+  if (!any) {
+    std::fprintf(stderr, "mmpm_roofline: --only \"%s\" matches no case label (", only);
+    for (const Case& c : cases) std::fprintf(stderr, "%s\"%s\"", &c == cases ? "" : ", ", c.label);
+    std::fprintf(stderr, ")\n");
+    return 2;
   }
   const double bw = triad_bandwidth(threads), peak = peak_gflops(threads);
   std::printf("machine (%d thread%s): triad %.1f GB/s, peak FMA %.1f GFLOP/s (double, 8 lanes)\n\n",
               threads, threads > 1 ? "s" : "", bw, peak);
   std::printf("%-22s %-13s %9s %9s %9s %8s %8s %9s %7s\n", "case", "stage", "ns/part", "B/part",
               "flop/part", "GB/s", "GFLOP/s", "bound ns", "x bound");
-  const Case cases[] = {{"2D linear double", 2, "linear", "double", 2},
-                        {"2D gimp double", 2, "gimp", "double", 3},
-                        {"2D gimp float", 2, "gimp", "float", 3},
-                        {"3D gimp double", 3, "gimp", "double", 3}};
   for (const Case& c : cases) {
+    if (only && !std::strstr(c.label, only)) continue;
     mmpm::Scene scene;
     try {
       scene = mmpm::parse_scene_text(block_scene(c), "roofline.toml");
@@ -158,8 +170,7 @@ int main(int argc, char** argv) {
     const double grid_per_p = nn / np * R * 2.0;  // one array read + written once per step
     // The force needs the in-plane stresses only: 3 of the 4 in 2D (not zz).
     const int NS_force = D == 2 ? 3 : 6;
-    const double p2g_bytes =
-        R * (2 * D + 2 + NS_force + (gimp ? D : 0)) + grid_per_p * (1 + 2 * D);
+    const double p2g_bytes = R * (2 * D + 2 + NS_force + (gimp ? D : 0)) + grid_per_p * (1 + 2 * D);
     const double g2p_bytes =
         R * (2 * D + (gimp ? D : 0)) + 4 + R * (2 * D + D * D) + grid_per_p / 2 * (2 * D);
     const double con_bytes = R * (D * D + NS + 1) + R * (NS + 1);
@@ -176,7 +187,7 @@ int main(int argc, char** argv) {
                 {"constitutive", mmpm::kStageConstitutive, con_bytes, con_flops}};
     const double peak_real = R == 8.0 ? peak : 2 * peak;
     for (const Row& r : rows) {
-      const double t = best[std::size_t(r.idx)] / steps / np * 1e9;  // ns per particle
+      const double t = best[std::size_t(r.idx)] / steps / np * 1e9;      // ns per particle
       const double bound = std::max(r.bytes / bw, r.flops / peak_real);  // ns (bytes / (GB/s) = ns)
       std::printf("%-22s %-13s %9.2f %9.0f %9.0f %8.2f %8.2f %9.2f %7.2f\n", c.label, r.stage, t,
                   r.bytes, r.flops, r.bytes / t, r.flops / t, bound, t / bound);
