@@ -23,6 +23,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -120,9 +121,8 @@ int main(int argc, char** argv) {
                         {"2D gimp double", 2, "gimp", "double", 3},
                         {"2D gimp float", 2, "gimp", "float", 3},
                         {"3D gimp double", 3, "gimp", "double", 3}};
-  bool any = false;
-  for (const Case& c : cases) any = any || !only || std::strstr(c.label, only);
-  if (!any) {
+  auto selected = [only](const Case& c) { return !only || std::strstr(c.label, only); };
+  if (std::none_of(std::begin(cases), std::end(cases), selected)) {
     std::fprintf(stderr, "mmpm_roofline: --only \"%s\" matches no case label (", only);
     for (const Case& c : cases) std::fprintf(stderr, "%s\"%s\"", &c == cases ? "" : ", ", c.label);
     std::fprintf(stderr, ")\n");
@@ -134,7 +134,7 @@ int main(int argc, char** argv) {
   std::printf("%-22s %-13s %9s %9s %9s %8s %8s %9s %7s\n", "case", "stage", "ns/part", "B/part",
               "flop/part", "GB/s", "GFLOP/s", "bound ns", "x bound");
   for (const Case& c : cases) {
-    if (only && !std::strstr(c.label, only)) continue;
+    if (!selected(c)) continue;
     mmpm::Scene scene;
     try {
       scene = mmpm::parse_scene_text(block_scene(c), "roofline.toml");
