@@ -36,6 +36,7 @@ void bm_mm_scene(benchmark::State& state, const std::string& scene, int threads)
     GridView<2, double> G = stepper->grid();
     MultimaterialStage<2, double>& mm = stepper->multimaterial();
     const NodeOwnership& own = stepper->ownership();
+    const MixedTiles<2>& mixed = stepper->mixed_tiles();
     const std::size_t total = G.nodes * std::size_t(G.fields);
     std::vector<std::vector<double>> saved;
     for (int d = 0; d < 2; ++d) saved.emplace_back(G.p[d], G.p[d] + total);
@@ -50,7 +51,7 @@ void bm_mm_scene(benchmark::State& state, const std::string& scene, int threads)
         restore_owned(G.fi[d], saved[std::size_t(2 + d)].data(), G.nodes, G.fields);
       }
       const auto t0 = Clock::now();
-      mm.find_nodes(G, own);
+      mm.find_nodes(G, own, &mixed);
       const auto ta = Clock::now();
       mm.pass_a(G, sim.dt(), own);
       const auto tb = Clock::now();
@@ -76,6 +77,7 @@ void bm_mm_scene(benchmark::State& state, const std::string& scene, int threads)
     set_ns_per_particle(state, n);  // stage time per scene particle
     set_ns_per_item(state, "ns_per_mm_node", double(mm.nodes().size()));
     state.counters["mm_nodes"] = double(mm.nodes().size());
+    state.counters["scanned_nodes"] = double(mixed.mixed_node_count());  // of grid_nodes
     state.counters["grid_nodes"] = double(G.nodes);
     const double us = 1e6 / double(state.iterations());
     state.counters["find_us"] = t_find * us;

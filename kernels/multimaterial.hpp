@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "kernels/grid_view.hpp"
+#include "kernels/mixed_tiles.hpp"
 #include "kernels/mm_common.hpp"
 #include "kernels/mm_contact.hpp"
 #include "kernels/mm_interface.hpp"
@@ -150,9 +151,13 @@ void fields_present(const Real* m, std::size_t nodes, int fields, Real threshold
 // Nodes where at least two fields have m > mass_threshold, in ascending order.
 // Blocks of nodes are counted and listed by the thread that owns them
 // (kernels/node_ownership.hpp); the list does not depend on who did which.
+// With `mixed` (kernels/mixed_tiles.hpp) only the nodes of tiles next to
+// particles of two or more fields are read: the same list, as no other node
+// can hold two fields' mass.
 template <int D, class Real>
 void find_multimaterial_nodes(const GridView<D, Real>& grid, Real mass_threshold,
-                              std::vector<std::uint32_t>& list, const NodeOwnership& own = {}) {
+                              std::vector<std::uint32_t>& list, const NodeOwnership& own = {},
+                              const MixedTiles<D>* mixed = nullptr) {
   using mm_detail::kFindBlock;
   using mm_detail::kFindGroup;
   const std::size_t nodes = grid.nodes;
@@ -174,12 +179,23 @@ void find_multimaterial_nodes(const GridView<D, Real>& grid, Real mass_threshold
     auto block_count = [&](std::size_t b) {
       return std::min(nodes, (b + 1) * kFindBlock) - b * kFindBlock;
     };
+    // body(first, count) over the nodes of block b that can hold two
+    // fields: runs of mixed tiles, or the whole block without `mixed`.
+    auto for_candidates = [&](std::size_t b, auto&& body) {
+      if (mixed)
+        mixed->for_each_mixed_run(b * kFindBlock, block_count(b), body);
+      else
+        body(b * kFindBlock, block_count(b));
+    };
     for (std::size_t b = b0; b < b1; ++b) {
-      const std::size_t count = block_count(b);
-      unsigned char* present = present_all.get() + b * kFindBlock;
-      mm_detail::fields_present(grid.m, nodes, F, mass_threshold, b * kFindBlock, count, present);
       std::size_t multi = 0;
-      for (std::size_t i = 0; i < count; ++i) multi += present[i] >= 2;
+      for_candidates(b, [&](std::size_t first, std::size_t count) {
+        unsigned char* present = present_all.get() + first;
+        mm_detail::fields_present(grid.m, nodes, F, mass_threshold, first, count, present);
+        unsigned run_multi = 0;  // a local: the byte stores above may alias a captured count
+        for (std::size_t i = 0; i < count; ++i) run_multi += present[i] >= 2;
+        multi += run_multi;
+      });
       offset[b + 1] = multi;
     }
 #pragma omp barrier
@@ -189,19 +205,20 @@ void find_multimaterial_nodes(const GridView<D, Real>& grid, Real mass_threshold
       list.resize(offset[blocks]);
     }
     for (std::size_t b = b0; b < b1; ++b) {
-      const std::size_t count = block_count(b);
-      const unsigned char* present = present_all.get() + b * kFindBlock;
       std::size_t out = 0;
-      for (std::size_t g = 0; g < count; g += kFindGroup) {
-        const std::size_t n = std::min(kFindGroup, count - g);
-        if (n == kFindGroup && !mm_detail::any_two_or_more(present + g)) continue;
-        // Written unconditionally, kept by advancing: no branch to mispredict
-        // on a mixed group (a third of the nodes in the 625-disk scene).
-        for (std::size_t i = g; i < g + n; ++i) {
-          found[out] = std::uint32_t(b * kFindBlock + i);
-          out += present[i] >= 2;
+      for_candidates(b, [&](std::size_t first, std::size_t count) {
+        const unsigned char* present = present_all.get() + first;
+        for (std::size_t g = 0; g < count; g += kFindGroup) {
+          const std::size_t n = std::min(kFindGroup, count - g);
+          if (n == kFindGroup && !mm_detail::any_two_or_more(present + g)) continue;
+          // Written unconditionally, kept by advancing: no branch to mispredict
+          // on a mixed group (a third of the nodes in the 625-disk scene).
+          for (std::size_t i = g; i < g + n; ++i) {
+            found[out] = std::uint32_t(first + i);
+            out += present[i] >= 2;
+          }
         }
-      }
+      });
       std::copy(found, found + out, list.begin() + std::ptrdiff_t(offset[b]));
     }
   }

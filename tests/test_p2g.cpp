@@ -49,6 +49,7 @@
 #include "kernels/binning.hpp"
 #include "kernels/g2p.hpp"
 #include "kernels/grid_view.hpp"
+#include "kernels/mixed_tiles.hpp"
 #include "kernels/multimaterial.hpp"
 #include "kernels/p2g.hpp"
 #include "kernels/p2g_multimaterial.hpp"
@@ -553,6 +554,70 @@ TYPED_TEST(P2G, MultimaterialFieldsFromReachingTilesMatchFullScatterBand) {
 TYPED_TEST(P2G, MultimaterialFieldsFromReachingTilesMatchFullScatterMixed) {
   check_multimaterial_fields<TypeParam::D, typename TypeParam::Shape, typename TypeParam::Real>(
       false, 0.0, 312);
+}
+
+// The multimaterial node search reading only the nodes of tiles next to
+// particles of two fields (kernels/mixed_tiles.hpp) lists the same nodes as
+// the full scan. Fields split by the plane x = mid + shift (the two-layer
+// scene's one interface), the plane moved through a tile in quarter cells,
+// with one particle of field 1 deep inside field 0 (a patch of its own); and
+// fields mixed everywhere, where every node is read. On 1 and 2 threads.
+template <int D, class Shape, class Real>
+void check_mixed_tile_search(bool split, double shift, unsigned seed) {
+  const bool gimp = std::string(Shape::name) == "gimp";
+  const std::size_t n = D == 2 ? 6000 : 4000;
+  Grid<D, Real> g(grid_cells<D>(), 2);
+  auto p = random_particles<D, Real>(g.G, g.cells, n, seed);
+  const double h = double(g.G.h[0]), x0 = double(g.G.origin[0]);
+  if (split) {
+    const double mid = x0 + (0.5 * g.cells[0] + shift) * h;
+    for (std::size_t i = 0; i < n; ++i) p.field[i] = std::uint8_t(double(p.x[0][i]) > mid);
+    p.x[0][0] = Real(x0 + 3.3 * h);  // the lone particle of field 1
+    p.field[0] = 1;
+  }
+  TileLayout<D> tiles;
+  tiles.setup(4, g.cells);
+  auto sorted = p.permuted(sort_by_tile(p, g.G, tiles));
+  TileSchedule r;
+  r.build(tiles, sorted.key.data(), n);
+  colored_p2g<D, Shape, Real, kMassMomentum, true, false>(sorted.view(gimp), g.G, P2GOptions{}, r,
+                                                          1);
+  std::vector<std::uint32_t> full;
+  find_multimaterial_nodes(g.G, Real(0), full);
+  ASSERT_FALSE(full.empty());
+  MixedTiles<D> mixed;
+  mixed.build(tiles, g.G.nodes_per_dim, r.begin, sorted.field.data());
+  std::vector<std::uint32_t> list;
+  find_multimaterial_nodes(g.G, Real(0), list, NodeOwnership{}, &mixed);
+  EXPECT_EQ(list, full);
+  const int saved = omp_get_max_threads();
+  omp_set_num_threads(2);
+  NodeOwnership own;
+  own.split = {0, g.G.nodes / 3, g.G.nodes};
+  std::vector<std::uint32_t> owned;
+  find_multimaterial_nodes(g.G, Real(0), owned, own, &mixed);
+  omp_set_num_threads(saved);
+  EXPECT_EQ(owned, full);
+  // 2D: 10 tile columns, the plane's neighbourhood is 3 or 4 of them (3D:
+  // too small a grid to leave a tile out).
+  const std::size_t scanned = mixed.mixed_node_count();
+  if (!split) {
+    EXPECT_EQ(scanned, g.G.nodes);
+  } else if (D == 2) {
+    EXPECT_LT(scanned, g.G.nodes / 2) << "the search skips the single-field tiles";
+  }
+}
+
+TYPED_TEST(P2G, MixedTileSearchListsTheFullScansNodesSplit) {
+  for (int k = 0; k < 16; ++k) {
+    SCOPED_TRACE("plane shifted by " + std::to_string(0.25 * k) + " cells");
+    check_mixed_tile_search<TypeParam::D, typename TypeParam::Shape, typename TypeParam::Real>(
+        true, 0.25 * k, 511 + unsigned(k));
+  }
+}
+TYPED_TEST(P2G, MixedTileSearchListsTheFullScansNodesMixed) {
+  check_mixed_tile_search<TypeParam::D, typename TypeParam::Shape, typename TypeParam::Real>(
+      false, 0.0, 512);
 }
 
 // Particles over the whole range a shape allows (window.hpp: linear

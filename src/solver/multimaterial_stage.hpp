@@ -66,10 +66,13 @@ class MultimaterialStage {
   bool has_interface_forces() const { return enabled_ && has_interface_; }
 
   // The step's multimaterial nodes, from the masses of the first P2G.
-  // `own`: which thread works on which nodes (kernels/node_ownership.hpp).
-  void find_nodes(const GridView<D, Real>& grid, const NodeOwnership& own) {
+  // `own`: which thread works on which nodes (kernels/node_ownership.hpp);
+  // `mixed`: where the particles of several fields meet
+  // (kernels/mixed_tiles.hpp), the only nodes read.
+  void find_nodes(const GridView<D, Real>& grid, const NodeOwnership& own,
+                  const MixedTiles<D>* mixed = nullptr) {
     if (!enabled_) return;
-    find_multimaterial_nodes(grid, cfg_.mass_threshold, list_, own);
+    find_multimaterial_nodes(grid, cfg_.mass_threshold, list_, own, mixed);
   }
   const std::vector<std::uint32_t>& nodes() const { return list_; }
 

@@ -72,6 +72,7 @@ class Stepper final : public Simulation {
   GridView<D, Real>& grid() { return G_; }
   MultimaterialStage<D, Real>& multimaterial() { return mm_; }
   const NodeOwnership& ownership() const { return own_; }
+  const MixedTiles<D>& mixed_tiles() const { return mixed_tiles_; }
 
  private:
   // The tile test G2P runs on every particle: inline, from copies of the
@@ -154,7 +155,8 @@ class Stepper final : public Simulation {
   TileSchedule schedule_;  // tile ranges and each thread's tiles per color
   NodeOwnership own_;      // each thread's nodes in the node loops
   std::size_t own_threads_ = 0;
-  ReachTiles reach_tiles_;  // tiles reaching a multimaterial node (p2g_multimaterial)
+  ReachTiles reach_tiles_;     // tiles reaching a multimaterial node (p2g_multimaterial)
+  MixedTiles<D> mixed_tiles_;  // where multimaterial nodes can be (rebuilt with the tile ranges)
   // This step's first P2G also scatters mx, vol, g (chosen from the share of
   // particles the previous step's multimaterial nodes reached).
   bool mm_fields_with_p2g_ = false;

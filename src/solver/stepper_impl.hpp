@@ -211,6 +211,7 @@ void Stepper<D, Shape, Real>::rebuild_ranges() {
   const std::size_t n = P_.n;
   schedule_.build(tiles_, P_.key, n);
   update_node_ownership(true);
+  if (plan_.multimaterial) mixed_tiles_.build(tiles_, G_.nodes_per_dim, schedule_.begin, P_.field);
   if (!material_particles_.empty()) {
     for (auto& l : material_particles_) l.clear();
     for (std::size_t p = 0; p < n; ++p) material_particles_[P_.mat[p]].push_back(std::uint32_t(p));
@@ -587,7 +588,7 @@ void Stepper<D, Shape, Real>::step() {
 
   if (mm) {
     tic();
-    mm_.find_nodes(G_, own_);
+    mm_.find_nodes(G_, own_, &mixed_tiles_);
     toc(kStageMultimaterial);
     tic();
     p2g_multimaterial();

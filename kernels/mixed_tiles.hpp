@@ -1,0 +1,149 @@
+// Where multimaterial nodes can be: the tiles whose neighbourhood holds
+// particles of two or more fields. The multimaterial node search
+// (kernels/multimaterial.hpp) scans only their nodes.
+//
+// Why: a node gets mass only from the particles of the cells around it, so a
+// node whose neighbouring tiles hold one field's particles has one field's
+// mass and cannot be a multimaterial node. In a scene with one interface
+// line (the two-layer scene: ~250 multimaterial nodes of 65 025) the search
+// read 2 x 65 025 masses per step, about half of the multimaterial stage;
+// it now reads 2 x 12 240 (docs/multimaterial.md, "Only where two fields
+// meet", has the numbers).
+//
+// A node i (per direction) receives from cells i - hi .. i + lo, hi, lo <= 2
+// (kernels/tile_reach.hpp), and tiles are at least 4 cells wide, so those
+// cells lie in tile(i) - 1 .. tile(i) + 1, where tile(i) = i >> shift,
+// clamped to the last tile (the last node row of a grid whose cells fill its
+// tiles exactly). The flags are valid while every particle stays in the tile
+// of its key, which the solver ensures: a particle that changes tile makes
+// the next step re-sort before its P2G (Stepper::step).
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "kernels/binning.hpp"
+
+namespace mmpm {
+
+template <int D>
+struct MixedTiles {
+  TileLayout<D> layout;
+  std::array<int, 3> nodes_per_dim{1, 1, 1};
+  // mixed[t]: tiles t - 1 .. t + 1 (in every direction) hold particles of
+  // two or more fields.
+  std::vector<std::uint8_t> mixed;
+  // Per tile row r = ty + tiles_y tz: the node intervals [x0, x1) along x
+  // of its runs of mixed tiles, spans[span_begin[r] .. span_begin[r + 1]).
+  std::vector<std::uint32_t> span_begin;
+  std::vector<std::array<std::uint32_t, 2>> spans;
+
+  // From the tile ranges of the sorted particles (TileSchedule::begin) and
+  // their fields.
+  void build(const TileLayout<D>& tiles, const std::array<int, 3>& nodes,
+             const std::vector<std::uint32_t>& begin, const std::uint8_t* field) {
+    layout = tiles;
+    nodes_per_dim = nodes;
+    const std::size_t nt = layout.tile_count;
+    // Per tile: kEmpty, kSeveral, or the one field its particles have.
+    constexpr int kEmpty = -1, kSeveral = -2;
+    std::vector<int> one(nt, kEmpty);
+    for (std::size_t t = 0; t < nt; ++t) {
+      for (std::uint32_t p = begin[t]; p < begin[t + 1]; ++p) {
+        const int f = field[p];
+        if (one[t] == kEmpty) {
+          one[t] = f;
+        } else if (one[t] != f) {
+          one[t] = kSeveral;
+          break;
+        }
+      }
+    }
+    mixed.assign(nt, 0);
+    const auto& n = layout.tiles;
+    for (int tz = 0; tz < n[2]; ++tz)
+      for (int ty = 0; ty < n[1]; ++ty)
+        for (int tx = 0; tx < n[0]; ++tx) {
+          int seen = kEmpty;
+          bool two = false;
+          for (int z = std::max(0, tz - 1); z <= std::min(n[2] - 1, tz + 1) && !two; ++z)
+            for (int y = std::max(0, ty - 1); y <= std::min(n[1] - 1, ty + 1) && !two; ++y)
+              for (int x = std::max(0, tx - 1); x <= std::min(n[0] - 1, tx + 1) && !two; ++x) {
+                const int f = one[index(x, y, z)];
+                if (f == kEmpty) continue;
+                two = f == kSeveral || (seen != kEmpty && seen != f);
+                seen = f;
+              }
+          mixed[index(tx, ty, tz)] = two;
+        }
+    span_begin.assign(std::size_t(n[1]) * std::size_t(n[2]) + 1, 0);
+    spans.clear();
+    const auto nx = std::uint32_t(nodes_per_dim[0]);
+    for (int tz = 0; tz < n[2]; ++tz)
+      for (int ty = 0; ty < n[1]; ++ty) {
+        for (int tx = 0; tx < n[0]; ++tx) {
+          if (!mixed[index(tx, ty, tz)]) continue;
+          const auto x0 = std::uint32_t(tx) << layout.shift;
+          const std::uint32_t x1 = tx + 1 == n[0] ? nx : std::uint32_t(tx + 1) << layout.shift;
+          const bool extends =
+              spans.size() > span_begin[std::size_t(ty + n[1] * tz)] && spans.back()[1] == x0;
+          if (extends)
+            spans.back()[1] = x1;
+          else
+            spans.push_back({x0, x1});
+        }
+        span_begin[std::size_t(ty + n[1] * tz) + 1] = std::uint32_t(spans.size());
+      }
+  }
+
+  // body(first, count) for each maximal run of nodes in [first, first +
+  // count) (flat node indices of one field, x fastest) whose tile is mixed.
+  template <class Body>
+  void for_each_mixed_run(std::size_t first, std::size_t count, Body&& body) const {
+    const auto nx = std::size_t(nodes_per_dim[0]), ny = std::size_t(nodes_per_dim[1]);
+    const std::size_t end = first + count;
+    std::size_t run = end, run_end = end;  // the open run [run, run_end), run == end: none
+    std::size_t row = first / nx, y = row % ny, z = row / ny;
+    for (std::size_t row_start = row * nx; row_start < end; row_start += nx) {
+      const std::size_t r =
+          std::size_t(tile_along(1, y)) +
+          std::size_t(layout.tiles[1]) * std::size_t(D == 3 ? tile_along(2, z) : 0);
+      for (std::uint32_t k = span_begin[r]; k < span_begin[r + 1]; ++k) {
+        const std::size_t a = std::max(first, row_start + spans[k][0]);
+        const std::size_t b = std::min(end, row_start + spans[k][1]);
+        if (a >= b) continue;
+        if (run != end && run_end == a) {
+          run_end = b;  // continues the open run (across a row end too)
+        } else {
+          if (run != end) body(run, run_end - run);
+          run = a, run_end = b;
+        }
+      }
+      if (++y == ny) y = 0, ++z;
+    }
+    if (run != end) body(run, run_end - run);
+  }
+
+  // Nodes of the mixed tiles (each node counted in the tile that holds it).
+  std::size_t mixed_node_count() const {
+    std::size_t nodes = 1;
+    for (int d = 0; d < D; ++d) nodes *= std::size_t(nodes_per_dim[std::size_t(d)]);
+    std::size_t c = 0;
+    for_each_mixed_run(0, nodes, [&](std::size_t, std::size_t k) { c += k; });
+    return c;
+  }
+
+ private:
+  std::size_t index(int x, int y, int z) const {
+    return std::size_t(x) + std::size_t(layout.tiles[0]) *
+                                (std::size_t(y) + std::size_t(layout.tiles[1]) * std::size_t(z));
+  }
+  int tile_along(int d, std::size_t node) const {
+    return std::min(int(node >> layout.shift), layout.tiles[std::size_t(d)] - 1);
+  }
+};
+
+}  // namespace mmpm
