@@ -1024,6 +1024,22 @@ TEST(MultimaterialNodes, FindsAscendingNodesWithTwoOrMoreFields) {
   omp_set_num_threads(saved);
 }
 
+TEST(MultimaterialNodes, TwoOrMoreBitsMatchACountByCountTest) {
+  // The word-at-a-time mask of the listing (kernels/multimaterial.hpp) against
+  // one comparison per count: counts 0, 1, 2, 3 and 255, runs of 1 to 64
+  // counts (whole words and a tail of 1 to 7).
+  std::mt19937 rng(17);
+  const unsigned char values[] = {0, 0, 0, 1, 1, 2, 3, 255};
+  for (int trial = 0; trial < 4000; ++trial) {
+    unsigned char counts[64];
+    for (auto& c : counts) c = values[rng() % 8];
+    const std::size_t n = 1 + std::size_t(trial) % 64;
+    std::uint64_t expected = 0;
+    for (std::size_t k = 0; k < n; ++k) expected |= std::uint64_t(counts[k] >= 2) << k;
+    ASSERT_EQ(mmpm::mm_detail::two_or_more_bits(counts, n), expected) << "trial " << trial;
+  }
+}
+
 TEST(MultimaterialNodes, FindsSparseNodesAtGroupEdges) {
   // The listing passes over 64-node groups without a multimaterial node
   // (kernels/multimaterial.hpp, any_two_or_more): one interface column, as in
