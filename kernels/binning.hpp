@@ -69,6 +69,11 @@ struct TileLayout {
     return (tile << key_shift) | local;
   }
   std::uint32_t tile_of_key(std::uint32_t k) const { return k >> key_shift; }
+  // Index of the tile at tile coordinates (tx, ty, tz), x fastest.
+  std::size_t tile_index(int tx, int ty, int tz) const {
+    return std::size_t(tx) +
+           std::size_t(tiles[0]) * (std::size_t(ty) + std::size_t(tiles[1]) * std::size_t(tz));
+  }
   int color(std::uint32_t tile) const {
     int col = 0;
     for (int d = 0; d < D; ++d) {

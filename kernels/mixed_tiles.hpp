@@ -33,9 +33,6 @@ template <int D>
 struct MixedTiles {
   TileLayout<D> layout;
   std::array<int, 3> nodes_per_dim{1, 1, 1};
-  // mixed[t]: tiles t - 1 .. t + 1 (in every direction) hold particles of
-  // two or more fields.
-  std::vector<std::uint8_t> mixed;
   // Per tile row r = ty + tiles_y tz: the node intervals [x0, x1) along x
   // of its runs of mixed tiles, spans[span_begin[r] .. span_begin[r + 1]).
   std::vector<std::uint32_t> span_begin;
@@ -62,7 +59,9 @@ struct MixedTiles {
         }
       }
     }
-    mixed.assign(nt, 0);
+    // mixed[t]: tiles t - 1 .. t + 1 (in every direction) hold particles of
+    // two or more fields.
+    std::vector<std::uint8_t> mixed(nt, 0);
     const auto& n = layout.tiles;
     for (int tz = 0; tz < n[2]; ++tz)
       for (int ty = 0; ty < n[1]; ++ty)
@@ -72,12 +71,12 @@ struct MixedTiles {
           for (int z = std::max(0, tz - 1); z <= std::min(n[2] - 1, tz + 1) && !two; ++z)
             for (int y = std::max(0, ty - 1); y <= std::min(n[1] - 1, ty + 1) && !two; ++y)
               for (int x = std::max(0, tx - 1); x <= std::min(n[0] - 1, tx + 1) && !two; ++x) {
-                const int f = one[index(x, y, z)];
+                const int f = one[layout.tile_index(x, y, z)];
                 if (f == kEmpty) continue;
                 two = f == kSeveral || (seen != kEmpty && seen != f);
                 seen = f;
               }
-          mixed[index(tx, ty, tz)] = two;
+          mixed[layout.tile_index(tx, ty, tz)] = two;
         }
     span_begin.assign(std::size_t(n[1]) * std::size_t(n[2]) + 1, 0);
     spans.clear();
@@ -85,7 +84,7 @@ struct MixedTiles {
     for (int tz = 0; tz < n[2]; ++tz)
       for (int ty = 0; ty < n[1]; ++ty) {
         for (int tx = 0; tx < n[0]; ++tx) {
-          if (!mixed[index(tx, ty, tz)]) continue;
+          if (!mixed[layout.tile_index(tx, ty, tz)]) continue;
           const auto x0 = std::uint32_t(tx) << layout.shift;
           const std::uint32_t x1 = tx + 1 == n[0] ? nx : std::uint32_t(tx + 1) << layout.shift;
           const bool extends =
@@ -137,10 +136,6 @@ struct MixedTiles {
   }
 
  private:
-  std::size_t index(int x, int y, int z) const {
-    return std::size_t(x) + std::size_t(layout.tiles[0]) *
-                                (std::size_t(y) + std::size_t(layout.tiles[1]) * std::size_t(z));
-  }
   int tile_along(int d, std::size_t node) const {
     return std::min(int(node >> layout.shift), layout.tiles[std::size_t(d)] - 1);
   }

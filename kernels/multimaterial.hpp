@@ -219,7 +219,7 @@ void find_multimaterial_nodes(const GridView<D, Real>& grid, Real mass_threshold
       for_candidates(b, [&](std::size_t first, std::size_t count) {
         unsigned char* present = present_all.get() + first;
         mm_detail::fields_present(grid.m, nodes, F, mass_threshold, first, count, present);
-        unsigned run_multi = 0;  // a local: the byte stores above may alias a captured count
+        unsigned run_multi = 0;  // a local: `multi` is a captured reference
         for (std::size_t i = 0; i < count; ++i) run_multi += present[i] >= 2;
         multi += run_multi;
       });

@@ -48,10 +48,7 @@ void mark_tiles_reaching(const TileLayout<D>& layout, const std::array<int, 3>& 
     }
     for (int tz = tlo[2]; tz <= thi[2]; ++tz)
       for (int ty = tlo[1]; ty <= thi[1]; ++ty)
-        for (int tx = tlo[0]; tx <= thi[0]; ++tx)
-          flag[std::size_t(tx) +
-               std::size_t(layout.tiles[0]) *
-                   (std::size_t(ty) + std::size_t(layout.tiles[1]) * std::size_t(tz))] = 1;
+        for (int tx = tlo[0]; tx <= thi[0]; ++tx) flag[layout.tile_index(tx, ty, tz)] = 1;
   }
 }
 
