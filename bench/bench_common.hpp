@@ -50,6 +50,7 @@ void register_sort();
 void register_step();
 void register_mm_scene();
 void register_scaling();
+void register_step_pair();
 
 // The 2D linear one-material scene (bench_scaling.cpp): a square block of
 // `cells` x `cells` cells, 2 x 2 particles per cell, in a grid 4 cells wider.
@@ -62,8 +63,11 @@ std::array<double, 7> set_stage_counters(benchmark::State& state,
                                          const std::array<double, 7>& after, double steps,
                                          double particles);
 
-// The whole-step scenes of bench_step.cpp that bench_mm_scene.cpp also
-// uses, by name ("2d_gimp_interface", "2d_gimp_inclusions"), and their schemes.
+// The whole-step scenes of bench_step.cpp that bench_mm_scene.cpp and
+// bench_step_pair.cpp also use, by name ("2d_linear_1mat",
+// "2d_gimp_interface", "2d_gimp_inclusions", "3d_gimp_1mat"), and their
+// schemes. The Simulation is the one the step/... benchmarks of that scene
+// (without overrides) step.
 Simulation& step_scene_simulation(const std::string& scene);
 Scheme step_scene_scheme(const std::string& scene);
 

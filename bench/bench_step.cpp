@@ -269,6 +269,8 @@ void add(const StepCase& c, int threads) {
 }
 
 StepCase shared_case(const std::string& scene) {
+  if (scene == "2d_linear_1mat") return {scene, linear_block_scene(250), {}};
+  if (scene == "3d_gimp_1mat") return {scene, kGimp3D, {}};
   if (scene == "2d_gimp_interface") return {scene, two_layer(true, true), {}};
   if (scene == "2d_gimp_inclusions") return {scene, inclusions_scene(), {}};
   throw std::invalid_argument("no whole-step scene named " + scene);

@@ -380,6 +380,46 @@ def step_section(R):
         out += ["", f"Target for the 2D uGIMP two-layer scene with an interface, one core: ≤ 80 "
                     f"ns/particle/step — measured {fmt(gi)}, {verdict} the target."]
     out += stage_speedup_table(R)
+    out += paired_speedup_table(R)
+    return out
+
+
+def paired_speedup_table(R):
+    """step_pair/... (bench/bench_step_pair.cpp): one benchmark per scene
+    alternates blocks of steps on 1 and 2 threads, so each ratio compares
+    two blocks taken seconds apart instead of two benchmarks taken minutes
+    apart. Per stage: the median over the passes of the median paired ratio,
+    and [the ratio of the per-thread-count minima]."""
+    scenes = [(scene, label) for scene, label, kw in step_scenes() if len(kw) == 1
+              and R.find("step_pair", scene=scene) is not None]
+    if not scenes:
+        return []
+    out = ["", "### 2-thread speed-up per stage, paired blocks (target ≥ 1.8×)", "",
+           "`step_pair/scene:...`: one benchmark per scene alternates blocks of 4 steps on 1 and "
+           "on 2 threads of the same simulation (order 1,2 / 2,1 / ...; one untimed step after "
+           "each switch), so both sides of a ratio see the same minutes of the shared host. "
+           "Cell: median over the pairs of the paired ratio (median over the passes), "
+           "[min over the 1-thread blocks / min over the 2-thread blocks], "
+           "(1-thread → 2-thread ns/particle/step, minima). Marked * below 1.8×. "
+           "Stages under 0.05 ns/particle are left out.", ""]
+    parts = ["step"] + STAGES
+    rows = []
+    for scene, label in scenes:
+        cells = []
+        for s in parts:
+            sp = R.value("step_pair", f"speedup_{s}", stat="median", scene=scene)
+            sm = R.value("step_pair", f"speedup_{s}_min", stat="median", scene=scene)
+            n1 = R.value("step_pair", f"ns1_{s}", stat="min", scene=scene)
+            n2 = R.value("step_pair", f"ns2_{s}", stat="min", scene=scene)
+            if sp is None or n1 is None or n1 < 0.05 or not sp:
+                cells.append("–")
+                continue
+            mark = "" if sp >= 1.8 else " *"
+            d = 2 if n1 < 10 else 1
+            cells.append(f"{sp:.2f}×{mark} [{sm:.2f}×] ({fmt(n1, d)} → {fmt(n2, d)})")
+        pairs = R.value("step_pair", "pairs", stat="median", scene=scene)
+        rows.append([f"`{scene}`: {label}", fmt(pairs, 0)] + cells)
+    out.append(table(["scene", "pairs"] + parts, rows))
     return out
 
 

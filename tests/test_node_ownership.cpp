@@ -1,5 +1,6 @@
 // Which thread works on which grid nodes (kernels/node_ownership.hpp): the
-// split follows the particles' tiles, and the node loops that use it give
+// split follows the particles' tiles (balanced inside the band the threads
+// share), and the node loops that use it give
 // the same results whatever the split and the thread count.
 #include <gtest/gtest.h>
 #include <omp.h>
@@ -29,35 +30,62 @@ std::vector<std::uint32_t> block_keys(const mmpm::TileLayout<D>& layout, std::ar
   return keys;
 }
 
-TEST(NodeOwnership, CutsAtTheTileWhereEachThreadsParticlesBegin2D) {
-  // 64 x 64 cells (65 x 65 nodes), tiles of 8: an 8 x 8 tile grid. One
-  // particle per cell in every cell: particle n/2 is the first of tile row
-  // 4, so thread 1 owns the nodes from row 32 up.
+TEST(NodeOwnership, CutsNearestTheEvenSplitInsideTheMedianTilesBand2D) {
+  // 64 x 64 cells (65 x 65 = 4225 nodes), tiles of 8: an 8 x 8 tile grid.
+  // One particle per cell in every cell: particle n/2 is the first of tile
+  // row 4, whose band is node rows 32 .. 40, and the even cut (node 2112,
+  // row 32.5) lies inside it.
   mmpm::TileLayout<2> layout;
   layout.setup(8, {64, 64, 1});
   const std::array<int, 3> nodes{65, 65, 1};
   const auto keys = block_keys<2>(layout, {0, 0, 0}, {64, 64, 1});
   const NodeOwnership two = mmpm::node_ownership<2>(layout, nodes, keys.data(), keys.size(), 2);
-  EXPECT_EQ(two.split, (std::vector<std::size_t>{0, 32 * 65, 65 * 65}));
-  // Four threads: tile rows 2, 4, 6.
+  EXPECT_EQ(two.split, (std::vector<std::size_t>{0, 2112, 65 * 65}));
+  // Four threads: tile rows 2, 4, 6 (bands from rows 16, 32, 48) hold the
+  // even cuts 1056, 2112, 3168.
   const NodeOwnership four = mmpm::node_ownership<2>(layout, nodes, keys.data(), keys.size(), 4);
-  EXPECT_EQ(four.split, (std::vector<std::size_t>{0, 16 * 65, 32 * 65, 48 * 65, 65 * 65}));
+  EXPECT_EQ(four.split, (std::vector<std::size_t>{0, 1056, 2112, 3168, 65 * 65}));
   // Particles only in the upper-right quarter (cells 32..63): particle n/2
-  // is in tile row 6 (cells 48..55), first tile x = 4 (cell 32).
+  // is in tile row 6 (band rows 48 .. 56); the even cut lies below the
+  // band, so the cut is the band's first node.
   const auto quarter = block_keys<2>(layout, {32, 32, 0}, {64, 64, 1});
   const NodeOwnership q = mmpm::node_ownership<2>(layout, nodes, quarter.data(), quarter.size(), 2);
-  EXPECT_EQ(q.split, (std::vector<std::size_t>{0, 48 * 65 + 32, 65 * 65}));
+  EXPECT_EQ(q.split, (std::vector<std::size_t>{0, 48 * 65, 65 * 65}));
+  // Particles only in cells x 0..31, y 0..15: particle n/2 is in tile row 1
+  // (band rows 8 .. 16); the even cut lies above, so the cut is the band's
+  // end and no node row that only thread 0 wrote goes to thread 1.
+  const auto low = block_keys<2>(layout, {0, 0, 0}, {32, 16, 1});
+  const NodeOwnership l = mmpm::node_ownership<2>(layout, nodes, low.data(), low.size(), 2);
+  EXPECT_EQ(l.split, (std::vector<std::size_t>{0, 16 * 65, 65 * 65}));
 }
 
-TEST(NodeOwnership, CutsAtTheTileWhereEachThreadsParticlesBegin3D) {
-  // 16^3 cells, tiles of 4: particle n/2 is the first of tile layer z = 2
-  // (cell 8), so thread 1 owns nodes from z layer 8 up.
+TEST(NodeOwnership, CutsNearestTheEvenSplitInsideTheMedianTilesBand3D) {
+  // 16^3 cells (17^3 = 4913 nodes), tiles of 4: particle n/2 is the first of
+  // tile layer z = 2 (band: node layers 8 .. 12), which holds the even cut.
   mmpm::TileLayout<3> layout;
   layout.setup(4, {16, 16, 16});
   const std::array<int, 3> nodes{17, 17, 17};
   const auto keys = block_keys<3>(layout, {0, 0, 0}, {16, 16, 16});
   const NodeOwnership two = mmpm::node_ownership<3>(layout, nodes, keys.data(), keys.size(), 2);
-  EXPECT_EQ(two.split, (std::vector<std::size_t>{0, 8 * 17 * 17, 17 * 17 * 17}));
+  EXPECT_EQ(two.split, (std::vector<std::size_t>{0, 4913 / 2, 17 * 17 * 17}));
+}
+
+TEST(NodeOwnership, ThickTileLayersNoLongerLeaveOneThreadAThirdOfTheNodes) {
+  // The 3d_gimp_1mat bench geometry: 28 x 28 x 26 cells (29 x 29 x 27 =
+  // 22 707 nodes), tiles of 8, particles in cells 2..25 x 2..25 x 2..23.
+  // Particle n/2 lies in tile layer z = 1 (node layers 8 .. 16). Its tile's
+  // first node is in layer 8: a cut there gave thread 0 ~30 % of the
+  // nodes. The cut is now the even one, inside the same band.
+  mmpm::TileLayout<3> layout;
+  layout.setup(8, {28, 28, 26});
+  const std::array<int, 3> nodes{29, 29, 27};
+  const auto keys = block_keys<3>(layout, {2, 2, 2}, {26, 26, 24});
+  const NodeOwnership two = mmpm::node_ownership<3>(layout, nodes, keys.data(), keys.size(), 2);
+  const std::size_t total = 29 * 29 * 27, layer = 29 * 29;
+  EXPECT_EQ(layout.tile_of_key(keys[keys.size() / 2]) / 16, 1u);  // tile layer z = 1
+  EXPECT_EQ(two.split, (std::vector<std::size_t>{0, total / 2, total}));
+  EXPECT_GE(two.split[1], 8 * layer);
+  EXPECT_LE(two.split[1], 16 * layer);
 }
 
 TEST(NodeOwnership, OtherTeamSizesAndNoParticlesGetAnEvenSplit) {
