@@ -1,7 +1,7 @@
 // Which thread works on which grid nodes (kernels/node_ownership.hpp): the
 // split follows the particles' tiles (balanced inside the band the threads
-// share), and the node loops that use it give
-// the same results whatever the split and the thread count.
+// share), and the node loops that use it give the same results whatever
+// the split and the thread count.
 #include <gtest/gtest.h>
 #include <omp.h>
 
