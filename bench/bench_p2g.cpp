@@ -24,11 +24,16 @@ enum class Strategy { colored, serial, atomic, colored_pointwise, serial_pointwi
 
 const char* strategy_name(Strategy s) {
   switch (s) {
-    case Strategy::colored: return "colored";
-    case Strategy::serial: return "serial";
-    case Strategy::atomic: return "atomic";
-    case Strategy::colored_pointwise: return "colored_pointwise";
-    case Strategy::serial_pointwise: return "serial_pointwise";
+    case Strategy::colored:
+      return "colored";
+    case Strategy::serial:
+      return "serial";
+    case Strategy::atomic:
+      return "atomic";
+    case Strategy::colored_pointwise:
+      return "colored_pointwise";
+    case Strategy::serial_pointwise:
+      return "serial_pointwise";
   }
   return "?";
 }
@@ -131,7 +136,8 @@ void register_case() {
                            "/real:" + real_name<Real>() + "/strategy:";
   auto add = [&](Strategy s, int tile, int threads) {
     std::string name = base + strategy_name(s);
-    if (s == Strategy::colored || s == Strategy::colored_pointwise) name += "/tile:" + std::to_string(tile);
+    if (s == Strategy::colored || s == Strategy::colored_pointwise)
+      name += "/tile:" + std::to_string(tile);
     name += "/threads:" + std::to_string(threads);
     auto* b = benchmark::RegisterBenchmark(name.c_str(), [s, tile, threads](benchmark::State& st) {
       bm_p2g<D, Shape, Real>(st, s, tile, threads);
@@ -157,8 +163,9 @@ void register_tiles() {
   for (int tile : {4, 8, 16, 32})
     for (int threads : {1, 2}) {
       const std::string name = "p2g_tile/dim:" + std::to_string(D) + "/shape:" + Shape::name +
-                               "/real:" + real_name<Real>() + "/strategy:colored/tile:" +
-                               std::to_string(tile) + "/threads:" + std::to_string(threads);
+                               "/real:" + real_name<Real>() +
+                               "/strategy:colored/tile:" + std::to_string(tile) +
+                               "/threads:" + std::to_string(threads);
       auto* b = benchmark::RegisterBenchmark(name.c_str(), [tile, threads](benchmark::State& st) {
         bm_p2g<D, Shape, Real>(st, Strategy::colored, tile, threads);
       });

@@ -130,8 +130,10 @@ std::size_t p2g_range_one_block(const ParticleView<D, Real>& particles,
   const auto off = Win::offsets(G);
   Block block;
   const WindowBuilder<D, Shape, Real> builder(G);
-  auto build = [&](std::size_t first, std::size_t n, Win* w, bool* ok)
-      __attribute__((always_inline)) { builder.build_batch(P, first, n, w, ok); };
+  auto build = [&](std::size_t first, std::size_t n, Win * w, bool* ok)
+      __attribute__((always_inline)) {
+    builder.build_batch(P, first, n, w, ok);
+  };
   auto scatter = [&](std::size_t p, const Win* win) __attribute__((always_inline)) {
     if (!win) return false;
     block.at(win->base + field_offset<MultiField>(P, G, p), G, off);

@@ -37,9 +37,10 @@ std::pair<Vec3, Vec3> extent(const ParticleSeeds& s) {
 // A 2 x 1 box turned 90 degrees about the pivot (0, 0) occupies [-1, 0] x [0, 2]:
 // particles (2x2 per 0.5 mm cell) from -0.875 to -0.125 in x and 0.125 to 1.875 in y.
 TEST(Bodies, RotationAboutPivot) {
-  const std::string text = std::string(kBase) +
-                           "[[body]]\nmaterial = \"a\"\nshape = \"box\"\nmin = [0.0, 0.0]\nmax = [2.0, 1.0]\n"
-                           "rotate = 90.0\npivot = [0.0, 0.0]\n";
+  const std::string text =
+      std::string(kBase) +
+      "[[body]]\nmaterial = \"a\"\nshape = \"box\"\nmin = [0.0, 0.0]\nmax = [2.0, 1.0]\n"
+      "rotate = 90.0\npivot = [0.0, 0.0]\n";
   const ParticleSeeds s = make_particles(parse_scene_text(text, "pivot.toml"));
   EXPECT_EQ(s.x.size(), 32u);  // 2 mm^2 at 16 particles per mm^2
   const auto [lo, hi] = extent(s);
@@ -51,9 +52,10 @@ TEST(Bodies, RotationAboutPivot) {
 
 // Without a pivot the box turns about its own centre (1, 0.5): [0.5, 1.5] x [-0.5, 1.5].
 TEST(Bodies, RotationAboutOwnCentre) {
-  const std::string text = std::string(kBase) +
-                           "[[body]]\nmaterial = \"a\"\nshape = \"box\"\nmin = [0.0, 0.0]\nmax = [2.0, 1.0]\n"
-                           "rotate = 90.0\n";
+  const std::string text =
+      std::string(kBase) +
+      "[[body]]\nmaterial = \"a\"\nshape = \"box\"\nmin = [0.0, 0.0]\nmax = [2.0, 1.0]\n"
+      "rotate = 90.0\n";
   const ParticleSeeds s = make_particles(parse_scene_text(text, "centre.toml"));
   const auto [lo, hi] = extent(s);
   EXPECT_NEAR(lo[0], 0.625, 1e-12);
@@ -65,12 +67,14 @@ TEST(Bodies, RotationAboutOwnCentre) {
 // The later body replaces the earlier one's particles; the traction force on
 // a face sums to traction x face length x thickness.
 TEST(Bodies, OverlapReplacementAndTractionTotal) {
-  const std::string text = std::string(kBase) +
-                           "[[material]]\nname = \"b\"\ntype = \"isotropic\"\ndensity = 1.0\nE = 100.0\nnu = 0.3\n"
-                           "[[body]]\nname = \"matrix\"\nmaterial = \"a\"\nshape = \"box\"\nmin = [0.0, 0.0]\nmax = [2.0, 2.0]\n"
-                           "[[body]]\nmaterial = \"b\"\nshape = \"box\"\nmin = [0.5, 0.5]\nmax = [1.5, 1.5]\n"
-                           "[[load]]\nkind = \"traction\"\nwhere = { body = \"matrix\", face = \"y_max\" }\n"
-                           "traction = [0.0, 3.0]\n";
+  const std::string text =
+      std::string(kBase) +
+      "[[material]]\nname = \"b\"\ntype = \"isotropic\"\ndensity = 1.0\nE = 100.0\nnu = 0.3\n"
+      "[[body]]\nname = \"matrix\"\nmaterial = \"a\"\nshape = \"box\"\nmin = [0.0, 0.0]\nmax = "
+      "[2.0, 2.0]\n"
+      "[[body]]\nmaterial = \"b\"\nshape = \"box\"\nmin = [0.5, 0.5]\nmax = [1.5, 1.5]\n"
+      "[[load]]\nkind = \"traction\"\nwhere = { body = \"matrix\", face = \"y_max\" }\n"
+      "traction = [0.0, 3.0]\n";
   const ParticleSeeds s = make_particles(parse_scene_text(text, "overlap.toml"));
   EXPECT_EQ(s.x.size(), 64u);
   EXPECT_EQ(std::count(s.material.begin(), s.material.end(), 1), 16);

@@ -10,12 +10,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <nlohmann/json.hpp>
 #include <regex>
 #include <set>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "io/h5.hpp"
 #include "test_util.hpp"
@@ -25,7 +24,9 @@ namespace {
 using namespace mmpm_test;
 using nlohmann::json;
 
-std::string bar_scene() { return source_dir() + "/inputs/bar_vibration.toml"; }
+std::string bar_scene() {
+  return source_dir() + "/inputs/bar_vibration.toml";
+}
 
 // bar_vibration.toml with the line starting with `line_start` replaced by `replacement`.
 std::string edited_bar(const std::string& line_start, const std::string& replacement) {
@@ -89,7 +90,8 @@ const BadInput kBadInputs[] = {
     {"nu_half", "nu ", "nu      = 0.5", "material[0].nu", "nu      = 0.5"},
     {"body_outside_grid", "max ", "max      = [40.0, 1.0]", "body[0].max", "[40.0, 1.0]"},
     {"zero_cell", "cell ", "cell   = [0.0, 0.5]", "grid.cell", "[0.0, 0.5]"},
-    {"missing_material", "material = ", "material = \"unobtainium\"", "body[0].material", "unobtainium"},
+    {"missing_material", "material = ", "material = \"unobtainium\"", "body[0].material",
+     "unobtainium"},
 };
 
 class CliBadInput : public ::testing::TestWithParam<BadInput> {};
@@ -113,7 +115,8 @@ TEST_P(CliBadInput, Exit2WithOneMessageNamingFileLineKey) {
     EXPECT_EQ(r.exit_code, 2) << sub << "\n" << r.describe();
     const auto lines = lines_of(r.err);
     ASSERT_EQ(lines.size(), 1u) << sub << ": exactly one message\n" << r.describe();
-    EXPECT_TRUE(contains(lines[0], where)) << sub << ": names file and line " << where << "\n" << lines[0];
+    EXPECT_TRUE(contains(lines[0], where)) << sub << ": names file and line " << where << "\n"
+                                           << lines[0];
     EXPECT_TRUE(contains(lines[0], key)) << sub << ": names the key " << key << "\n" << lines[0];
     EXPECT_TRUE(r.out.empty()) << sub << ": nothing on stdout for bad input\n" << r.out;
     expect_no_result(out);
@@ -121,11 +124,14 @@ TEST_P(CliBadInput, Exit2WithOneMessageNamingFileLineKey) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Cli, CliBadInput, ::testing::ValuesIn(kBadInputs),
-                         [](const ::testing::TestParamInfo<BadInput>& i) { return std::string(i.param.name); });
+                         [](const ::testing::TestParamInfo<BadInput>& i) {
+                           return std::string(i.param.name);
+                         });
 
 TEST(Cli, BadSetValueIsBlamedOnTheSetOption) {
   TempDir tmp;
-  const CmdResult r = run_mmpm({"run", bar_scene(), "--set", "material[0].nu=0.5", "--out", (tmp / "o").string()});
+  const CmdResult r =
+      run_mmpm({"run", bar_scene(), "--set", "material[0].nu=0.5", "--out", (tmp / "o").string()});
   EXPECT_EQ(r.exit_code, 2) << r.describe();
   const auto lines = lines_of(r.err);
   ASSERT_EQ(lines.size(), 1u) << r.describe();
@@ -138,7 +144,8 @@ TEST(Cli, TimeStepAboveStabilityLimit) {
   const std::string scene = bar_scene();
   // run refuses it: exit 2, one message naming the file and the key, no output.
   {
-    const CmdResult r = run_mmpm({"run", scene, "--set", "simulation.cfl=1.5", "--out", (tmp / "a").string()});
+    const CmdResult r =
+        run_mmpm({"run", scene, "--set", "simulation.cfl=1.5", "--out", (tmp / "a").string()});
     EXPECT_EQ(r.exit_code, 2) << r.describe();
     const auto lines = lines_of(r.err);
     ASSERT_EQ(lines.size(), 1u) << r.describe();
@@ -148,15 +155,17 @@ TEST(Cli, TimeStepAboveStabilityLimit) {
   }
   // An explicit dt above the limit is refused the same way, naming simulation.dt.
   {
-    const CmdResult r = run_mmpm({"run", scene, "--set", "simulation.dt=1.0e-3", "--out", (tmp / "b").string()});
+    const CmdResult r =
+        run_mmpm({"run", scene, "--set", "simulation.dt=1.0e-3", "--out", (tmp / "b").string()});
     EXPECT_EQ(r.exit_code, 2) << r.describe();
     EXPECT_TRUE(contains(r.err, "simulation.dt")) << r.err;
     expect_no_result(tmp / "b");
   }
   // --force runs it (3 steps: short enough that the instability stays small).
   {
-    const CmdResult r = run_mmpm({"run", scene, "--set", "simulation.cfl=1.5", "--set", "simulation.end_time=0.0003",
-                              "--force", "--quiet", "--out", (tmp / "c").string()});
+    const CmdResult r = run_mmpm({"run", scene, "--set", "simulation.cfl=1.5", "--set",
+                                  "simulation.end_time=0.0003", "--force", "--quiet", "--out",
+                                  (tmp / "c").string()});
     EXPECT_EQ(r.exit_code, 0) << r.describe();
     EXPECT_TRUE(fs::exists(tmp / "c" / "summary.json"));
   }
@@ -174,31 +183,36 @@ TEST(Cli, UnstableRunNamesStageStepParticleAndLeavesNoResult) {
   const fs::path out = tmp / "out";
   // A complete result from an earlier run in the same directory must not survive
   // a failed run there either: it would look like this run's result.
-  const CmdResult ok = run_mmpm({"run", bar_scene(), "--set", "simulation.end_time=0.002", "--quiet", "--out", out.string()});
+  const CmdResult ok = run_mmpm(
+      {"run", bar_scene(), "--set", "simulation.end_time=0.002", "--quiet", "--out", out.string()});
   ASSERT_EQ(ok.exit_code, 0) << ok.describe();
   ASSERT_TRUE(fs::exists(out / "run.h5"));
   // 2000 mm/ms to the right: the bar reaches the grid edge after ~16 steps.
-  const CmdResult r = run_mmpm({"run", bar_scene(), "--set", "body[0].velocity=[2000.0, 0.0]", "--quiet", "--out",
-                            out.string()});
+  const CmdResult r = run_mmpm({"run", bar_scene(), "--set", "body[0].velocity=[2000.0, 0.0]",
+                                "--quiet", "--out", out.string()});
   EXPECT_NE(r.exit_code, 0) << r.describe();
   EXPECT_NE(r.exit_code, 2) << "not an input error: the scene is valid\n" << r.describe();
   const auto lines = lines_of(r.err);
   ASSERT_EQ(lines.size(), 1u) << r.describe();
-  EXPECT_TRUE(std::regex_search(lines[0], std::regex(R"(stage [a-z0-9_]+, step [0-9]+, particle [0-9]+)")))
+  EXPECT_TRUE(
+      std::regex_search(lines[0], std::regex(R"(stage [a-z0-9_]+, step [0-9]+, particle [0-9]+)")))
       << lines[0];
   expect_no_result(out);
   EXPECT_FALSE(fs::exists(out / "run.h5.partial"));
 }
 
-double number(const json& j, const char* key) { return j.at(key).get<double>(); }
+double number(const json& j, const char* key) {
+  return j.at(key).get<double>();
+}
 
 TEST(Cli, RunWritesResultsAndSummaryContract) {
   TempDir tmp;
   const fs::path out = tmp / "bar";
-  const CmdResult r = run_mmpm({"run", bar_scene(), "--set", "simulation.end_time=0.05", "--threads", "2", "--out",
-                            out.string()});
+  const CmdResult r = run_mmpm({"run", bar_scene(), "--set", "simulation.end_time=0.05",
+                                "--threads", "2", "--out", out.string()});
   ASSERT_EQ(r.exit_code, 0) << r.describe();
-  for (const char* f : {"run.h5", "run.xdmf", "summary.json"}) EXPECT_TRUE(fs::exists(out / f)) << f;
+  for (const char* f : {"run.h5", "run.xdmf", "summary.json"})
+    EXPECT_TRUE(fs::exists(out / f)) << f;
   EXPECT_FALSE(fs::exists(out / "run.h5.partial"));
   EXPECT_FALSE(fs::exists(out / "checkpoint.bin"));
   EXPECT_TRUE(contains(read_text(out / "run.xdmf"), "run.h5"));
@@ -206,16 +220,30 @@ TEST(Cli, RunWritesResultsAndSummaryContract) {
   const json j = json::parse(read_text(out / "summary.json"));
   std::set<std::string> keys;
   for (const auto& [k, v] : j.items()) keys.insert(k);
-  const std::set<std::string> expected{"scene", "dimension", "precision", "particles", "nodes", "materials",
-                                       "steps", "end_time", "dt", "threads", "wall_s", "ns_per_particle_step",
-                                       "stages_s", "energy", "multimaterial_nodes", "nodes_3plus",
-                                       "force_limited_nodes", "stopped_by"};
+  const std::set<std::string> expected{"scene",
+                                       "dimension",
+                                       "precision",
+                                       "particles",
+                                       "nodes",
+                                       "materials",
+                                       "steps",
+                                       "end_time",
+                                       "dt",
+                                       "threads",
+                                       "wall_s",
+                                       "ns_per_particle_step",
+                                       "stages_s",
+                                       "energy",
+                                       "multimaterial_nodes",
+                                       "nodes_3plus",
+                                       "force_limited_nodes",
+                                       "stopped_by"};
   EXPECT_EQ(keys, expected);
   std::set<std::string> stage_keys, energy_keys;
   for (const auto& [k, v] : j.at("stages_s").items()) stage_keys.insert(k);
   for (const auto& [k, v] : j.at("energy").items()) energy_keys.insert(k);
-  EXPECT_EQ(stage_keys, (std::set<std::string>{"sort", "p2g", "multimaterial", "grid", "g2p", "constitutive",
-                                               "output", "other"}));
+  EXPECT_EQ(stage_keys, (std::set<std::string>{"sort", "p2g", "multimaterial", "grid", "g2p",
+                                               "constitutive", "output", "other"}));
   EXPECT_EQ(energy_keys,
             (std::set<std::string>{"kinetic", "strain", "interface", "external_work", "damping"}));
 
@@ -262,15 +290,16 @@ TEST(Cli, RunWritesResultsAndSummaryContract) {
   ASSERT_FALSE(time.empty());
   EXPECT_EQ(time.back(), end);
   EXPECT_EQ(step.back(), double(steps));
-  EXPECT_TRUE(contains(root.string_attribute("scene"), "end_time = 0.05")) << root.string_attribute("scene");
+  EXPECT_TRUE(contains(root.string_attribute("scene"), "end_time = 0.05"))
+      << root.string_attribute("scene");
   EXPECT_GE(root.open_group("particles").children().size(), 2u) << "initial and final snapshots";
 }
 
 TEST(Cli, SweepWritesTableAndOneSummaryPerValue) {
   TempDir tmp;
   const fs::path out = tmp / "sweep";
-  const CmdResult r = run_mmpm({"sweep", bar_scene(), "--param", "simulation.end_time", "--values", "0.01,0.02", "--jobs",
-                            "2", "--quiet", "--out", out.string()});
+  const CmdResult r = run_mmpm({"sweep", bar_scene(), "--param", "simulation.end_time", "--values",
+                                "0.01,0.02", "--jobs", "2", "--quiet", "--out", out.string()});
   ASSERT_EQ(r.exit_code, 0) << r.describe();
   const auto rows = lines_of(read_text(out / "sweep.csv"));
   ASSERT_EQ(rows.size(), 3u) << "header + 2 rows";

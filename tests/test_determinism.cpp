@@ -81,7 +81,9 @@ RunResult run(const std::string& text, int threads, double drift) {
   return r;
 }
 
-bool same_bits(double a, double b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+bool same_bits(double a, double b) {
+  return std::memcmp(&a, &b, sizeof a) == 0;
+}
 
 void expect_identical(const RunResult& a, const RunResult& b) {
   ASSERT_EQ(a.particles, b.particles);
@@ -96,8 +98,8 @@ void expect_identical(const RunResult& a, const RunResult& b) {
         if (first == u.size()) first = i;
         ++count;
       }
-    EXPECT_EQ(count, 0u) << kFields[f] << ": " << count << " values differ, first at " << first << ": "
-                         << (first < u.size() ? u[first] : 0.0) << " (1 thread) vs "
+    EXPECT_EQ(count, 0u) << kFields[f] << ": " << count << " values differ, first at " << first
+                         << ": " << (first < u.size() ? u[first] : 0.0) << " (1 thread) vs "
                          << (first < u.size() ? v[first] : 0.0) << " (2 threads)";
   }
   const Energies& e = a.energies;
@@ -105,7 +107,8 @@ void expect_identical(const RunResult& a, const RunResult& b) {
   EXPECT_TRUE(same_bits(e.kinetic, g.kinetic)) << e.kinetic << " vs " << g.kinetic;
   EXPECT_TRUE(same_bits(e.strain, g.strain)) << e.strain << " vs " << g.strain;
   EXPECT_TRUE(same_bits(e.interface, g.interface)) << e.interface << " vs " << g.interface;
-  EXPECT_TRUE(same_bits(e.external_work, g.external_work)) << e.external_work << " vs " << g.external_work;
+  EXPECT_TRUE(same_bits(e.external_work, g.external_work))
+      << e.external_work << " vs " << g.external_work;
   EXPECT_TRUE(same_bits(e.damping, g.damping)) << e.damping << " vs " << g.damping;
   EXPECT_TRUE(same_bits(e.kinetic_unresolved, g.kinetic_unresolved))
       << e.kinetic_unresolved << " vs " << g.kinetic_unresolved;
@@ -170,9 +173,11 @@ BoxScene2D two_materials(const std::string& precision, const std::string& intera
 }
 
 const char* const kPerfectNormalInterface =
-    "law = \"interface\"\nDn = \"perfect\"\nDt = 5.0\nnormal = \"specified\"\nnormal_vector = [1.0, 0.0]\n";
+    "law = \"interface\"\nDn = \"perfect\"\nDt = 5.0\nnormal = \"specified\"\nnormal_vector = "
+    "[1.0, 0.0]\n";
 const char* const kNumericInterface =
-    "law = \"interface\"\nDn = 200.0\nDt = 5.0\nnormal = \"specified\"\nnormal_vector = [1.0, 0.0]\n";
+    "law = \"interface\"\nDn = 200.0\nDt = 5.0\nnormal = \"specified\"\nnormal_vector = [1.0, "
+    "0.0]\n";
 const char* const kFrictionContact =
     "law = \"friction\"\nfriction = 0.3\nseparation = \"position\"\nnormal = \"mvg\"\n";
 
@@ -195,7 +200,8 @@ TEST(Determinism, SingleMaterialLinear2DUSF) {
 }
 
 TEST(Determinism, ImperfectInterfacePerfectNormal2D) {
-  const RunResult r = check_scene(two_materials("double", kPerfectNormalInterface).text(), "2D gimp double", 40.0);
+  const RunResult r =
+      check_scene(two_materials("double", kPerfectNormalInterface).text(), "2D gimp double", 40.0);
   EXPECT_GT(r.counters.multimaterial_nodes, 0) << "the multimaterial pass must be active";
 }
 
@@ -204,11 +210,13 @@ TEST(Determinism, ImperfectInterfaceNumericDnMUSL2D) {
   s.scheme = "MUSL";
   const RunResult r = check_scene(s.text(), "2D gimp double", 40.0);
   EXPECT_GT(r.counters.multimaterial_nodes, 0);
-  EXPECT_GT(r.energies.interface, 0.0) << "a compliant interface stores energy once it opens or slides";
+  EXPECT_GT(r.energies.interface, 0.0)
+      << "a compliant interface stores energy once it opens or slides";
 }
 
 TEST(Determinism, ImperfectInterfaceFloat2D) {
-  const RunResult r = check_scene(two_materials("float", kNumericInterface).text(), "2D gimp float", 40.0);
+  const RunResult r =
+      check_scene(two_materials("float", kNumericInterface).text(), "2D gimp float", 40.0);
   EXPECT_GT(r.counters.multimaterial_nodes, 0);
 }
 

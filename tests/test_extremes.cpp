@@ -201,7 +201,8 @@ ramp = 0.1
 )";
   auto sim = make_from_text(scene);
   run_until(*sim, 1.5);
-  const auto d = field(*sim, "displacement"), x = field(*sim, "position"), V = field(*sim, "volume");
+  const auto d = field(*sim, "displacement"), x = field(*sim, "position"),
+             V = field(*sim, "volume");
   EXPECT_TRUE(all_finite(d.values));
   for (double v : V.values) EXPECT_GT(v, 0.0);
   double top = 0, ymax = 0;
@@ -243,7 +244,8 @@ velocity = [12.0, 0.0]
 )";
     auto sim = make_from_text(scene);
     run_until(*sim, 1.0);
-    const auto v = field(*sim, "velocity"), d = field(*sim, "displacement"), s = field(*sim, "stress");
+    const auto v = field(*sim, "velocity"), d = field(*sim, "displacement"),
+               s = field(*sim, "stress");
     double dv = 0, smax = 0, dd = 0;
     for (std::size_t q = 0; q < sim->particle_count(); ++q) {
       dv = std::max(dv, std::abs(v.at(q, 0) - 12.0) + std::abs(v.at(q, 1)));

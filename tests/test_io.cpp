@@ -33,9 +33,8 @@ class ScratchDir {
  public:
   ScratchDir() {
     const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    path_ = fs::temp_directory_path() /
-            ("mmpm_io_" + std::string(info->test_suite_name()) + "_" + info->name() + "_" +
-             std::to_string(::getpid()));
+    path_ = fs::temp_directory_path() / ("mmpm_io_" + std::string(info->test_suite_name()) + "_" +
+                                         info->name() + "_" + std::to_string(::getpid()));
     fs::remove_all(path_);
     fs::create_directories(path_);
   }
@@ -88,7 +87,8 @@ struct RawFile {
     }
     return true;
   }
-  std::vector<double> doubles(const std::string& path, std::vector<hsize_t>* shape = nullptr) const {
+  std::vector<double> doubles(const std::string& path,
+                              std::vector<hsize_t>* shape = nullptr) const {
     const hid_t ds = H5Dopen2(id, path.c_str(), H5P_DEFAULT);
     EXPECT_GE(ds, 0) << path;
     if (ds < 0) return {};
@@ -584,9 +584,13 @@ TEST(IoXdmf, EmptyRunIsAValidDocument) {
 
 // ---------------------------------------------------------------- run writer
 
-TEST(IoRunWriter, Writes2DRun) { write_and_check_run(2); }
+TEST(IoRunWriter, Writes2DRun) {
+  write_and_check_run(2);
+}
 
-TEST(IoRunWriter, Writes3DRun) { write_and_check_run(3); }
+TEST(IoRunWriter, Writes3DRun) {
+  write_and_check_run(3);
+}
 
 TEST(IoRunWriter, AbandonLeavesNothing) {
   ScratchDir scratch;
@@ -648,8 +652,7 @@ TEST(IoRunWriter, ReopenDeletesLaterSnapshotsAndEndsLikeAnUninterruptedRun) {
   EXPECT_EQ(file.children("/xdmf"), (std::vector<std::string>{"step_0000000000", "step_0000000010",
                                                               "step_0000000020", "vertices_5"}));
   const std::string xdmf = slurp(dir / "run.xdmf");
-  EXPECT_EQ(between(xdmf, "<Time Value=\"", "\"/>"),
-            (std::vector<std::string>{"0", "0.1", "0.2"}));
+  EXPECT_EQ(between(xdmf, "<Time Value=\"", "\"/>"), (std::vector<std::string>{"0", "0.1", "0.2"}));
 }
 
 TEST(IoRunWriter, ReopenAfterTheWritingProcessWasKilled) {
@@ -697,8 +700,7 @@ TEST(IoRunWriter, RewritingAStepReplacesIt) {
   writer.finish();
   const RawFile file(scratch.path() / "run.h5");
   expect_snapshot_in(file, again);
-  EXPECT_EQ(file.children("/xdmf"),
-            (std::vector<std::string>{"step_0000000003", "vertices_2"}));
+  EXPECT_EQ(file.children("/xdmf"), (std::vector<std::string>{"step_0000000003", "vertices_2"}));
 }
 
 TEST(IoRunWriter, RejectsInconsistentInput) {

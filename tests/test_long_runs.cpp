@@ -51,7 +51,8 @@ TEST(LongRuns, UnresolvedKineticEnergyDoesNotCreep) {
   double growth = 0;
   EXPECT_LT(unresolved_fraction({}, &growth), 1e-5);
   EXPECT_LE(growth, 2.0);
-  EXPECT_GT(unresolved_fraction({"simulation.flip=1.0"}, &growth), 1e-4) << "pure FLIP should show the creep";
+  EXPECT_GT(unresolved_fraction({"simulation.flip=1.0"}, &growth), 1e-4)
+      << "pure FLIP should show the creep";
 }
 
 // [stop] kinetic_ratio = 1e-4 held 400 steps ends the run early with stopped_by = "kinetic_ratio",
@@ -67,15 +68,17 @@ TEST(LongRuns, StopCriterionEndsStaticRunEarly) {
   const RunOutcome full = run_scene(coarse_two_layer({"simulation.end_time=0.6"}), opt, log);
   ASSERT_EQ(full.exit_code, 0) << full.message;
   opt.out = dir / "stopped";
-  const RunOutcome early = run_scene(coarse_two_layer({"simulation.end_time=0.6", "stop.enabled=true",
-                                                      "stop.kinetic_ratio=1.0e-4", "stop.hold_steps=400"}),
-                                     opt, log);
+  const RunOutcome early =
+      run_scene(coarse_two_layer({"simulation.end_time=0.6", "stop.enabled=true",
+                                  "stop.kinetic_ratio=1.0e-4", "stop.hold_steps=400"}),
+                opt, log);
   ASSERT_EQ(early.exit_code, 0) << early.message;
   EXPECT_EQ(full.summary["stopped_by"], "end_time");
   EXPECT_EQ(early.summary["stopped_by"], "kinetic_ratio");
   EXPECT_LT(early.summary["steps"].get<long>(), full.summary["steps"].get<long>());
   const auto stored = [](const RunOutcome& r) {
-    return r.summary["energy"]["strain"].get<double>() + r.summary["energy"]["interface"].get<double>();
+    return r.summary["energy"]["strain"].get<double>() +
+           r.summary["energy"]["interface"].get<double>();
   };
   EXPECT_NEAR(stored(early) / stored(full), 1.0, 0.005);
   fs::remove_all(dir);

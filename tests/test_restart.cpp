@@ -18,13 +18,12 @@
 
 #include <chrono>
 #include <cstring>
-#include <sstream>
 #include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "io/checkpoint.hpp"
 #include "io/h5.hpp"
@@ -123,7 +122,8 @@ RunFile read_run(const fs::path& file) {
   for (const std::string& name : particles.children()) {
     const h5::Group g = particles.open_group(name);
     r.snapshot_time_step[name] = {g.double_attribute("time"), g.int_attribute("step")};
-    for (const std::string& ds : g.children()) r.snapshots[name][ds] = g.open_dataset(ds).read_doubles();
+    for (const std::string& ds : g.children())
+      r.snapshots[name][ds] = g.open_dataset(ds).read_doubles();
   }
   const h5::Group series = root.open_group("series");
   std::string list = series.string_attribute("columns");
@@ -140,7 +140,8 @@ bool same_bits(const std::vector<double>& a, const std::vector<double>& b) {
 }
 
 std::string first_diff(const std::vector<double>& a, const std::vector<double>& b) {
-  if (a.size() != b.size()) return "sizes " + std::to_string(a.size()) + " vs " + std::to_string(b.size());
+  if (a.size() != b.size())
+    return "sizes " + std::to_string(a.size()) + " vs " + std::to_string(b.size());
   for (std::size_t i = 0; i < a.size(); ++i)
     if (std::memcmp(&a[i], &b[i], sizeof(double)) != 0) {
       std::ostringstream s;
@@ -166,7 +167,8 @@ void expect_same_run(const RunFile& ref, const RunFile& got) {
       EXPECT_TRUE(datasets.count(required)) << name << " lacks " << required;
     for (const auto& [ds, values] : datasets) {
       ASSERT_TRUE(other.count(ds)) << name << "/" << ds << " missing after restart";
-      EXPECT_TRUE(same_bits(values, other.at(ds))) << name << "/" << ds << " differs: " << first_diff(values, other.at(ds));
+      EXPECT_TRUE(same_bits(values, other.at(ds)))
+          << name << "/" << ds << " differs: " << first_diff(values, other.at(ds));
     }
   }
   // Series: same columns; all but the wall-clock timings bitwise equal.
@@ -175,11 +177,12 @@ void expect_same_run(const RunFile& ref, const RunFile& got) {
   for (const auto& c : ref.columns) {
     if (c.rfind("stage_", 0) == 0) continue;
     if (!got.series.count(c)) continue;
-    EXPECT_TRUE(same_bits(ref.series.at(c), got.series.at(c))) << "series " << c << ": "
-                                                               << first_diff(ref.series.at(c), got.series.at(c));
+    EXPECT_TRUE(same_bits(ref.series.at(c), got.series.at(c)))
+        << "series " << c << ": " << first_diff(ref.series.at(c), got.series.at(c));
     ++compared;
   }
-  for (const char* c : {"time", "step", "kinetic", "strain", "interface", "external_work", "damping"})
+  for (const char* c :
+       {"time", "step", "kinetic", "strain", "interface", "external_work", "damping"})
     EXPECT_TRUE(ref.series.count(c)) << "series column " << c;
   EXPECT_GE(compared, 7);
 }
@@ -191,7 +194,8 @@ TEST(Restart, KilledRunContinuesBitwise) {
 
   // 1. The uninterrupted run.
   const fs::path ref_dir = tmp / "ref";
-  const CmdResult ref = run_mmpm({"run", scene.string(), "--out", ref_dir.string(), "--threads", "1", "--quiet"});
+  const CmdResult ref =
+      run_mmpm({"run", scene.string(), "--out", ref_dir.string(), "--threads", "1", "--quiet"});
   ASSERT_EQ(ref.exit_code, 0) << ref.describe();
   const json ref_summary = json::parse(read_text(ref_dir / "summary.json"));
   const long steps = ref_summary.at("steps").get<long>();
@@ -204,11 +208,13 @@ TEST(Restart, KilledRunContinuesBitwise) {
   bool killed = false;
   for (double fraction : {0.4, 0.2, 0.08, 0.0}) {
     fs::remove_all(dir);
-    Child child({mmpm_binary(), "run", scene.string(), "--out", dir.string(), "--threads", "1", "--quiet"},
-                tmp / "killed.out", tmp / "killed.err");
+    Child child(
+        {mmpm_binary(), "run", scene.string(), "--out", dir.string(), "--threads", "1", "--quiet"},
+        tmp / "killed.out", tmp / "killed.err");
     const auto t0 = std::chrono::steady_clock::now();
     while (!child.poll_done()) {
-      const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      const double elapsed =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       if (fs::exists(dir / "checkpoint.bin") && elapsed >= fraction * ref.seconds) {
         child.kill_and_wait(SIGKILL);
         killed = child.result().signal == SIGKILL;
@@ -217,8 +223,8 @@ TEST(Restart, KilledRunContinuesBitwise) {
       std::this_thread::sleep_for(std::chrono::milliseconds(2));
     }
     if (killed) break;
-    ASSERT_EQ(child.result().exit_code, 0) << "the run to be killed failed by itself: "
-                                           << read_text(tmp / "killed.err");
+    ASSERT_EQ(child.result().exit_code, 0)
+        << "the run to be killed failed by itself: " << read_text(tmp / "killed.err");
   }
   ASSERT_TRUE(killed) << "could not kill the run before it finished";
   EXPECT_TRUE(fs::exists(dir / "checkpoint.bin"));
@@ -248,9 +254,11 @@ TEST(Restart, KilledRunContinuesBitwise) {
   EXPECT_EQ(got.at("end_time").get<double>(), ref_summary.at("end_time").get<double>());
   EXPECT_EQ(got.at("particles"), ref_summary.at("particles"));
   for (const char* e : {"kinetic", "strain", "interface", "external_work", "damping"})
-    EXPECT_EQ(got.at("energy").at(e).get<double>(), ref_summary.at("energy").at(e).get<double>()) << e;
+    EXPECT_EQ(got.at("energy").at(e).get<double>(), ref_summary.at("energy").at(e).get<double>())
+        << e;
   EXPECT_EQ(got.at("multimaterial_nodes"), ref_summary.at("multimaterial_nodes"));
-  EXPECT_GT(ref_summary.at("energy").at("interface").get<double>(), 0.0) << "the interface carries state";
+  EXPECT_GT(ref_summary.at("energy").at("interface").get<double>(), 0.0)
+      << "the interface carries state";
 }
 
 }  // namespace

@@ -4,13 +4,12 @@
 #pragma once
 
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <poll.h>
 #include <signal.h>
 #include <sys/types.h>
 #include <sys/wait.h>
 #include <unistd.h>
-
-#include <gtest/gtest.h>
 
 #include <cctype>
 #include <cerrno>
@@ -29,8 +28,12 @@ namespace mmpm_test {
 
 namespace fs = std::filesystem;
 
-inline std::string source_dir() { return MMPM_SOURCE_DIR; }
-inline std::string mmpm_binary() { return MMPM_BINARY; }
+inline std::string source_dir() {
+  return MMPM_SOURCE_DIR;
+}
+inline std::string mmpm_binary() {
+  return MMPM_BINARY;
+}
 
 // ------------------------------------------------------------------ files --
 
@@ -77,14 +80,16 @@ class TempDir {
 // -------------------------------------------------------------- processes --
 
 struct CmdResult {
-  int exit_code = -1;   // exit status, or -1 when killed by a signal
-  int signal = 0;       // the signal that ended it, 0 if it exited
+  int exit_code = -1;  // exit status, or -1 when killed by a signal
+  int signal = 0;      // the signal that ended it, 0 if it exited
   std::string out, err;
-  double seconds = 0;   // wall time
+  double seconds = 0;  // wall time
   std::string describe() const {
     std::ostringstream s;
     s << "exit " << exit_code << (signal ? " signal " + std::to_string(signal) : std::string())
-      << "\n--- stdout ---\n" << out << "--- stderr ---\n" << err;
+      << "\n--- stdout ---\n"
+      << out << "--- stderr ---\n"
+      << err;
     return s.str();
   }
 };
@@ -287,12 +292,15 @@ struct BoxScene2D {
       << "precision = \"" << precision << "\"\n\n"
       << "[grid]\norigin = [0.0, 0.0]\ncell = [" << cell << ", " << cell << "]\n"
       << "cells = [" << cells_x << ", " << cells_y << "]\nshape = \"" << shape << "\"\n\n"
-      << "[[material]]\nname = \"a\"\ntype = \"isotropic\"\ndensity = 1.0e-3\nE = 1000.0\nnu = 0.3\n\n";
+      << "[[material]]\nname = \"a\"\ntype = \"isotropic\"\ndensity = 1.0e-3\nE = 1000.0\nnu = "
+         "0.3\n\n";
     if (second_material)
-      s << "[[material]]\nname = \"b\"\ntype = \"isotropic\"\ndensity = 2.0e-3\nE = 3000.0\nnu = 0.25\n\n";
+      s << "[[material]]\nname = \"b\"\ntype = \"isotropic\"\ndensity = 2.0e-3\nE = 3000.0\nnu = "
+           "0.25\n\n";
     s << "[[body]]\nname = \"left\"\nmaterial = \"a\"\nshape = \"box\"\n"
-      << "min = [" << b0_min[0] << ", " << b0_min[1] << "]\nmax = [" << b0_max[0] << ", " << b0_max[1]
-      << "]\nparticles_per_cell = " << ppc << "\nvelocity = [" << b0_vel[0] << ", " << b0_vel[1] << "]\n\n";
+      << "min = [" << b0_min[0] << ", " << b0_min[1] << "]\nmax = [" << b0_max[0] << ", "
+      << b0_max[1] << "]\nparticles_per_cell = " << ppc << "\nvelocity = [" << b0_vel[0] << ", "
+      << b0_vel[1] << "]\n\n";
     if (two_bodies)
       s << "[[body]]\nname = \"right\"\nmaterial = \"" << (second_material ? "b" : "a")
         << "\"\nshape = \"box\"\n"

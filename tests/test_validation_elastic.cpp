@@ -29,9 +29,13 @@ end_time = 1.0
 cfl = 0.4
 [grid]
 origin = [-2.0, -2.0]
-cell = [)" + std::to_string(cell) + ", " + std::to_string(cell) + R"(]
-cells = [)" + std::to_string(int(std::lround(29.0 / cell))) + ", " + std::to_string(int(std::lround(5.0 / cell))) + R"(]
-shape = ")" + shape + R"("
+cell = [)" +
+         std::to_string(cell) + ", " + std::to_string(cell) + R"(]
+cells = [)" +
+         std::to_string(int(std::lround(29.0 / cell))) + ", " +
+         std::to_string(int(std::lround(5.0 / cell))) + R"(]
+shape = ")" +
+         shape + R"("
 [[material]]
 name = "steel"
 type = "isotropic"
@@ -74,7 +78,8 @@ BarResult run_bar(double cell, const std::string& shape, int periods) {
     const auto d = field(*sim, "displacement");
     const auto pos = field(*sim, "position");
     for (std::size_t p = 0; p < sim->particle_count(); ++p)
-      if (std::abs(pos.at(p, 0) - d.at(p, 0) - tip_x0) < 1e-9 && std::abs(pos.at(p, 1) - d.at(p, 1) - tip_y0) < 1e-9)
+      if (std::abs(pos.at(p, 0) - d.at(p, 0) - tip_x0) < 1e-9 &&
+          std::abs(pos.at(p, 1) - d.at(p, 1) - tip_y0) < 1e-9)
         return d.at(p, 0);
     return std::nan("");
   };
@@ -85,7 +90,8 @@ BarResult run_bar(double cell, const std::string& shape, int periods) {
     sim->step();
     const double u = tip_displacement();
     r.amplitude = std::max(r.amplitude, std::abs(u));
-    if (prev > 0 && u <= 0) crossings.push_back(prev_t + (sim->time() - prev_t) * prev / (prev - u));
+    if (prev > 0 && u <= 0)
+      crossings.push_back(prev_t + (sim->time() - prev_t) * prev / (prev - u));
     prev = u;
     prev_t = sim->time();
     if (sim->step_count() % 10 == 0) {
@@ -103,7 +109,7 @@ TEST(ValidationElastic, BarVibrationPeriodAndAmplitude) {
   const double L = 25, c = std::sqrt(200000 / 7.8e-3);
   const double T = 4 * L / c, A = 0.1 / (std::numbers::pi * c / (2 * L));
   const BarResult r = run_bar(0.5, "gimp", 4);
-  EXPECT_NEAR(r.period / T, 1.0, 0.005) << "period " << r.period << " vs " << T;   // 0.5 %
+  EXPECT_NEAR(r.period / T, 1.0, 0.005) << "period " << r.period << " vs " << T;          // 0.5 %
   EXPECT_NEAR(r.amplitude / A, 1.0, 0.01) << "amplitude " << r.amplitude << " vs " << A;  // 1 %
 }
 

@@ -41,7 +41,8 @@ std::string input_path(const std::string& name) {
   return std::string(MMPM_SOURCE_DIR) + "/inputs/" + name;
 }
 
-std::unique_ptr<Simulation> make_scene(const std::string& name, const std::vector<std::string>& ov) {
+std::unique_ptr<Simulation> make_scene(const std::string& name,
+                                       const std::vector<std::string>& ov) {
   return make_simulation(parse_scene_file(input_path(name), ov));
 }
 
@@ -54,7 +55,9 @@ std::string num(double v) {
   return s;
 }
 
-std::string stiffness_value(double D) { return std::isinf(D) ? "\"perfect\"" : num(D); }
+std::string stiffness_value(double D) {
+  return std::isinf(D) ? "\"perfect\"" : num(D);
+}
 
 // Least-squares line u = a y + b through the points (y, u).
 struct Line {
@@ -80,7 +83,8 @@ struct State {
   double x0(std::size_t p, int d) const { return pos.at(p, d) - disp.at(p, d); }
 };
 State state_of(const Simulation& sim) {
-  return {field(sim, "position"), field(sim, "displacement"), field(sim, "material"), sim.energies()};
+  return {field(sim, "position"), field(sim, "displacement"), field(sim, "material"),
+          sim.energies()};
 }
 
 // Line through displacement component `comp` against the initial coordinate y0 of
@@ -118,7 +122,8 @@ struct BarsResult {
   double slope_a = 0, slope_b = 0;  // strains of the bulk fields
 };
 
-BarsResult run_bars(double Dn, double sigma, double h, double t_end, const std::string& Dt = "\"perfect\"",
+BarsResult run_bars(double Dn, double sigma, double h, double t_end,
+                    const std::string& Dt = "\"perfect\"",
                     const std::vector<std::string>& extra = {}) {
   const int nx = int(std::lround(4.0 / h)), ny = int(std::lround(12.0 / h));
   std::vector<std::string> ov = {
@@ -156,9 +161,11 @@ TEST(ValidationInterface, SeriesBarsNormalCompliance) {
     const BarsResult r = run_bars(Dn, sigma, h, 1.0);
     const auto ex = analytic::series_bars(E, 5.0, E, 5.0, Dn, A, sigma * A);
     SCOPED_TRACE("Dn = " + num(Dn));
-    std::printf("[bars h=0.5] Dn %-8g compliance %+.3f %%  opening %.5g (continuum %.5g)  U_int/exact %.4f\n", Dn,
-                100 * (r.compliance / ex.compliance - 1), r.jump, ex.jump,
-                std::isinf(Dn) ? 0.0 : r.e.interface / ex.U_interface);
+    std::printf(
+        "[bars h=0.5] Dn %-8g compliance %+.3f %%  opening %.5g (continuum %.5g)  U_int/exact "
+        "%.4f\n",
+        Dn, 100 * (r.compliance / ex.compliance - 1), r.jump, ex.jump,
+        std::isinf(Dn) ? 0.0 : r.e.interface / ex.U_interface);
     EXPECT_TRUE(finite(r.e));
     EXPECT_LT(r.e.kinetic, 1e-5 * (r.e.strain + r.e.interface)) << "not static";
     EXPECT_NEAR(r.compliance / ex.compliance, 1.0, 0.015)
@@ -241,9 +248,10 @@ TEST(ValidationInterface, ShearStackTangentialCompliance) {
     const ShearResult r = run_shear(Dt, tau, 0.8);
     const auto ex = analytic::shear_stack(G1, 2.0, G2, 2.0, Dt, tau);
     SCOPED_TRACE("Dt = " + num(Dt));
-    std::printf("[shear h=0.5] Dt %-8g u_top %+.3f %%  slip %.5g (continuum %.5g)  U_int/exact %.4f\n", Dt,
-                100 * (r.top / ex.top_displacement - 1), r.jump, ex.jump,
-                std::isinf(Dt) ? 0.0 : r.e.interface / (ex.U_interface_per_area * W));
+    std::printf(
+        "[shear h=0.5] Dt %-8g u_top %+.3f %%  slip %.5g (continuum %.5g)  U_int/exact %.4f\n", Dt,
+        100 * (r.top / ex.top_displacement - 1), r.jump, ex.jump,
+        std::isinf(Dt) ? 0.0 : r.e.interface / (ex.U_interface_per_area * W));
     EXPECT_TRUE(finite(r.e));
     EXPECT_LT(r.e.kinetic, 1e-5 * (r.e.strain + r.e.interface)) << "not static";
     const double model_top = ex.top_displacement - (std::isinf(Dt) ? 0.0 : tau * bias);
@@ -252,7 +260,8 @@ TEST(ValidationInterface, ShearStackTangentialCompliance) {
           << "u_top " << r.top << " exact " << ex.top_displacement;
     } else {
       EXPECT_NEAR(r.top / model_top, 1.0, 0.005)
-          << "u_top " << r.top << " exact " << ex.top_displacement << " with the bias " << model_top;
+          << "u_top " << r.top << " exact " << ex.top_displacement << " with the bias "
+          << model_top;
     }
     if (!std::isinf(Dt)) {
       EXPECT_NEAR((r.jump - (ex.jump - tau * bias)) / ex.jump, 0.0, 0.01) << "slip " << r.jump;
@@ -274,9 +283,9 @@ struct DlsRun {
 
 DlsRun run_dls(double Dt, double h, double t_end, const std::vector<std::string>& extra = {}) {
   const int nx = int(std::lround(5.0 / h)), ny = int(std::lround(37.0 / h));
-  std::vector<std::string> ov = {"interaction[0].Dt=" + stiffness_value(Dt),
-                                 "grid.cell=[" + num(h) + "," + num(h) + "]",
-                                 "grid.cells=[" + std::to_string(nx) + "," + std::to_string(ny) + "]"};
+  std::vector<std::string> ov = {
+      "interaction[0].Dt=" + stiffness_value(Dt), "grid.cell=[" + num(h) + "," + num(h) + "]",
+      "grid.cells=[" + std::to_string(nx) + "," + std::to_string(ny) + "]"};
   ov.insert(ov.end(), extra.begin(), extra.end());
   auto sim = make_scene("dls.toml", ov);
   run_until(*sim, t_end);
@@ -298,8 +307,10 @@ TEST(ValidationInterface, DlsStiffnessVsShearLag) {
     const DlsRun r = run_dls(1.0 / inv, 0.5, 0.25);
     const auto ex = analytic::DlsShearLag({}, {}, 1.0 / inv).result();
     SCOPED_TRACE("1/Dt = " + num(inv));
-    std::printf("[dls h=0.5] 1/Dt %.2f  k %.2f  shear lag %.2f (%+.2f %%)  interface share %.4f (theory %.4f)\n", inv,
-                r.k, ex.k, 100 * (r.k / ex.k - 1), r.interface_fraction, ex.interface_fraction);
+    std::printf(
+        "[dls h=0.5] 1/Dt %.2f  k %.2f  shear lag %.2f (%+.2f %%)  interface share %.4f (theory "
+        "%.4f)\n",
+        inv, r.k, ex.k, 100 * (r.k / ex.k - 1), r.interface_fraction, ex.interface_fraction);
     EXPECT_TRUE(finite(r.e));
     EXPECT_NEAR(r.k / ex.k, 1.0, 0.02) << "k = " << r.k << " shear lag " << ex.k;
     EXPECT_NEAR(r.interface_fraction, ex.interface_fraction, 0.01);
@@ -319,7 +330,8 @@ TEST(ValidationInterfaceLong, DlsStiffnessRefinement) {
     const double exact = analytic::dls_stiffness(Dt);
     const DlsRun c = run_dls(Dt, 0.5, 0.25), f = run_dls(Dt, 0.25, 0.25);
     err_coarse.push_back(c.k / exact - 1), err_fine.push_back(f.k / exact - 1);
-    std::printf("[dls] 1/Dt = %.2f  k(0.5) = %.2f  k(0.25) = %.2f  shear lag %.2f\n", inv, c.k, f.k, exact);
+    std::printf("[dls] 1/Dt = %.2f  k(0.5) = %.2f  k(0.25) = %.2f  shear lag %.2f\n", inv, c.k, f.k,
+                exact);
     EXPECT_NEAR(f.k / exact, 1.0, inv == 0 ? 0.02 : 0.015) << "1/Dt = " << inv;
   }
   EXPECT_LT(std::abs(err_fine[0]), std::abs(err_coarse[0]));
@@ -332,12 +344,13 @@ TEST(ValidationInterfaceLong, DlsStiffnessRefinement) {
 double two_layer_interface_energy(double h, double Dt, bool midplane, double t_end) {
   const double x0 = -1.0 - (midplane ? 0.5 * h : 0.0);
   const int nx = int(std::lround(10.0 / h)), ny = int(std::lround(22.0 / h));
-  auto sim = make_scene("two_layer.toml",
-                        {"grid.cell=[" + num(h) + "," + num(h) + "]", "grid.origin=[" + num(x0) + ",-1.0]",
-                         "grid.cells=[" + std::to_string(nx) + "," + std::to_string(ny) + "]",
-                         "interaction[0].Dt=" + num(Dt), "interaction[0].Dn=\"perfect\"",
-                         "interaction[0].normal=\"specified\"", "interaction[0].min_volume=0.0",
-                         "boundary[0].where={min=[-2.0,-2.0],max=[10.0,0.0]}"});
+  auto sim =
+      make_scene("two_layer.toml",
+                 {"grid.cell=[" + num(h) + "," + num(h) + "]", "grid.origin=[" + num(x0) + ",-1.0]",
+                  "grid.cells=[" + std::to_string(nx) + "," + std::to_string(ny) + "]",
+                  "interaction[0].Dt=" + num(Dt), "interaction[0].Dn=\"perfect\"",
+                  "interaction[0].normal=\"specified\"", "interaction[0].min_volume=0.0",
+                  "boundary[0].where={min=[-2.0,-2.0],max=[10.0,0.0]}"});
   run_until(*sim, t_end);
   const Energies e = sim->energies();
   EXPECT_TRUE(finite(e));
@@ -356,8 +369,8 @@ double two_layer_interface_energy(double h, double Dt, bool midplane, double t_e
 TEST(ValidationInterface, TwoLayerInterfaceLocationIndependence) {
   const double grid = two_layer_interface_energy(0.5, 2.0, false, 0.8);
   const double mid = two_layer_interface_energy(0.5, 2.0, true, 0.8);
-  std::printf("[two-layer h=0.5, 1/Dt=0.5] U_int grid line %.6g, midplane %.6g mJ (ratio %.4f)\n", grid, mid,
-              mid / grid);
+  std::printf("[two-layer h=0.5, 1/Dt=0.5] U_int grid line %.6g, midplane %.6g mJ (ratio %.4f)\n",
+              grid, mid, mid / grid);
   EXPECT_GT(grid, 0.0);
   EXPECT_NEAR(mid / grid, 1.0, 0.05);
 }
@@ -367,16 +380,20 @@ TEST(ValidationInterface, TwoLayerInterfaceLocationIndependence) {
 // 1/Dt = 0.1, 0.5 and 1 (static by 0.8 ms).
 TEST(ValidationInterfaceLong, TwoLayerInterfaceLocationIndependenceFine) {
   MMPM_LONG_TEST();
-  const double coarse = two_layer_interface_energy(0.5, 2.0, true, 0.8) / two_layer_interface_energy(0.5, 2.0, false, 0.8) - 1;
+  const double coarse = two_layer_interface_energy(0.5, 2.0, true, 0.8) /
+                            two_layer_interface_energy(0.5, 2.0, false, 0.8) -
+                        1;
   double fine_half = 0;
   for (double inv : {0.1, 0.5, 1.0}) {
     const double grid = two_layer_interface_energy(0.25, 1 / inv, false, 0.8);
     const double mid = two_layer_interface_energy(0.25, 1 / inv, true, 0.8);
-    std::printf("[two-layer h=0.25, 1/Dt=%.2f] U_int grid line %.6g, midplane %.6g mJ\n", inv, grid, mid);
+    std::printf("[two-layer h=0.25, 1/Dt=%.2f] U_int grid line %.6g, midplane %.6g mJ\n", inv, grid,
+                mid);
     EXPECT_NEAR(mid / grid, 1.0, 0.03) << "1/Dt = " << inv;
     if (inv == 0.5) fine_half = mid / grid - 1;
   }
-  EXPECT_NEAR(fine_half / coarse, 0.5, 0.15) << "gap h=0.5: " << coarse << ", h=0.25: " << fine_half;
+  EXPECT_NEAR(fine_half / coarse, 0.5, 0.15)
+      << "gap h=0.5: " << coarse << ", h=0.25: " << fine_half;
 }
 
 // ---------------------------------------------------------------------------
@@ -394,10 +411,11 @@ struct ExtremeRun {
 ExtremeRun run_extreme(double D, bool force_limit, const std::string& integration, double t_end) {
   ExtremeRun r;
   const std::string d = stiffness_value(D);
-  auto sim = make_scene("series_bars.toml",
-                        {"interaction[0].Dn=" + d, "interaction[0].Dt=" + d,
-                         std::string("interaction[0].force_limit=") + (force_limit ? "true" : "false"),
-                         "interaction[0].integration=\"" + integration + "\"", "load[0].traction=[0.0,0.001]"});
+  auto sim = make_scene(
+      "series_bars.toml",
+      {"interaction[0].Dn=" + d, "interaction[0].Dt=" + d,
+       std::string("interaction[0].force_limit=") + (force_limit ? "true" : "false"),
+       "interaction[0].integration=\"" + integration + "\"", "load[0].traction=[0.0,0.001]"});
   try {
     while (sim->time() < t_end) {
       sim->step();
@@ -428,9 +446,12 @@ TEST(ValidationInterface, ExtremesStableWithForceLimit) {
   for (double D : {analytic::kInf, 1e12, 1e9, 1e6, 1e3, 1.0, 1e-3}) {
     SCOPED_TRACE("D = " + num(D));
     const ExtremeRun r = run_extreme(D, true, "explicit", 0.4);
-    std::printf("[extremes, force limit] D %-8g threw %d  U %.4g (static %.4g)  U_int %.3g  C/C_perfect %.5f  limited %ld\n",
-                D, int(r.threw), r.e.strain + r.e.interface, analytic::series_bars(E, 5, E, 5, D, A, P).U_total,
-                r.e.interface, r.compliance / C_perfect, r.limited);
+    std::printf(
+        "[extremes, force limit] D %-8g threw %d  U %.4g (static %.4g)  U_int %.3g  C/C_perfect "
+        "%.5f  limited %ld\n",
+        D, int(r.threw), r.e.strain + r.e.interface,
+        analytic::series_bars(E, 5, E, 5, D, A, P).U_total, r.e.interface, r.compliance / C_perfect,
+        r.limited);
     ASSERT_FALSE(r.threw) << r.message;
     ASSERT_TRUE(finite(r.e));
     const auto ex = analytic::series_bars(E, 5, E, 5, D, A, P);
@@ -455,11 +476,12 @@ TEST(ValidationInterface, ExtremesUnstableWithoutForceLimit) {
     SCOPED_TRACE("D = " + num(D));
     const ExtremeRun r = run_extreme(D, false, "explicit", 0.05);
     const auto ex = analytic::series_bars(E, 5, E, 5, D, A, P);
-    std::printf("[extremes, no limit] D %-8g threw %d (%s)  U %.4g\n", D, int(r.threw), r.message.substr(0, 60).c_str(),
-                r.e.strain + r.e.interface + r.e.kinetic);
-    const bool blew_up = r.threw || !finite(r.e) ||
-                         r.e.strain + r.e.interface + r.e.kinetic > 10 * ex.U_total;
-    EXPECT_TRUE(blew_up) << "energy " << r.e.strain + r.e.interface + r.e.kinetic << " static " << ex.U_total;
+    std::printf("[extremes, no limit] D %-8g threw %d (%s)  U %.4g\n", D, int(r.threw),
+                r.message.substr(0, 60).c_str(), r.e.strain + r.e.interface + r.e.kinetic);
+    const bool blew_up =
+        r.threw || !finite(r.e) || r.e.strain + r.e.interface + r.e.kinetic > 10 * ex.U_total;
+    EXPECT_TRUE(blew_up) << "energy " << r.e.strain + r.e.interface + r.e.kinetic << " static "
+                         << ex.U_total;
   }
   const ExtremeRun soft = run_extreme(1.0, false, "explicit", 0.05);
   EXPECT_FALSE(soft.threw) << soft.message;
@@ -475,13 +497,14 @@ TEST(ValidationInterface, ExtremesExactIntegrationStable) {
   for (double D : {1e12, 1e6}) {
     SCOPED_TRACE("D = " + num(D));
     const ExtremeRun r = run_extreme(D, false, "exact", 0.4);
-    std::printf("[extremes, exact] D %-8g threw %d  C/C_perfect %.5f  limited %ld\n", D, int(r.threw),
-                r.compliance / C_perfect, r.limited);
+    std::printf("[extremes, exact] D %-8g threw %d  C/C_perfect %.5f  limited %ld\n", D,
+                int(r.threw), r.compliance / C_perfect, r.limited);
     ASSERT_FALSE(r.threw) << r.message;
     ASSERT_TRUE(finite(r.e));
     EXPECT_NEAR(r.compliance / C_perfect, 1.0, 0.005);
   }
-  const ExtremeRun ex = run_extreme(1e3, false, "exact", 0.4), ep = run_extreme(1e3, true, "explicit", 0.4);
+  const ExtremeRun ex = run_extreme(1e3, false, "exact", 0.4),
+                   ep = run_extreme(1e3, true, "explicit", 0.4);
   ASSERT_FALSE(ex.threw || ep.threw);
   EXPECT_NEAR(ex.compliance / ep.compliance, 1.0, 0.005);
 }
@@ -497,14 +520,16 @@ struct CubeRun {
 // inputs/sphere_in_cube.toml: 1 mm cube, eps0 = 0.5 %, symmetry planes held, outer
 // faces displaced (boxes 3, 4, 5). K from energy (P-35) and from the mean normal
 // reaction on the three outer faces, each of area 1 mm^2 (P-36).
-CubeRun run_cube(double D, double h, int ppc, double t_end, const std::vector<std::string>& extra = {}) {
+CubeRun run_cube(double D, double h, int ppc, double t_end,
+                 const std::vector<std::string>& extra = {}) {
   const int n = int(std::lround(1.3 / h));
-  std::vector<std::string> ov = {"interaction[0].Dn=" + stiffness_value(D), "interaction[0].Dt=" + stiffness_value(D),
-                                 "grid.cell=[" + num(h) + "," + num(h) + "," + num(h) + "]",
-                                 "grid.cells=[" + std::to_string(n) + "," + std::to_string(n) + "," +
-                                     std::to_string(n) + "]",
-                                 "body[0].particles_per_cell=" + std::to_string(ppc),
-                                 "body[1].particles_per_cell=" + std::to_string(ppc)};
+  std::vector<std::string> ov = {
+      "interaction[0].Dn=" + stiffness_value(D),
+      "interaction[0].Dt=" + stiffness_value(D),
+      "grid.cell=[" + num(h) + "," + num(h) + "," + num(h) + "]",
+      "grid.cells=[" + std::to_string(n) + "," + std::to_string(n) + "," + std::to_string(n) + "]",
+      "body[0].particles_per_cell=" + std::to_string(ppc),
+      "body[1].particles_per_cell=" + std::to_string(ppc)};
   ov.insert(ov.end(), extra.begin(), extra.end());
   auto sim = make_scene("sphere_in_cube.toml", ov);
   run_until(*sim, t_end);
@@ -539,8 +564,9 @@ double csa(double D) {
 TEST(ValidationInterface, SphereInCubeBulkModulusCoarse) {
   const CubeRun r = run_cube(1e4, 0.1, 1, 0.012);
   const double exact = csa(1e4);
-  std::printf("[cube h=0.1 ppc=1 1/D=1e-4] K_energy %.1f  K_pressure %.1f  CSA %.1f  U_int/U %.3f\n",
-              r.K_energy, r.K_pressure, exact, r.interface_fraction);
+  std::printf(
+      "[cube h=0.1 ppc=1 1/D=1e-4] K_energy %.1f  K_pressure %.1f  CSA %.1f  U_int/U %.3f\n",
+      r.K_energy, r.K_pressure, exact, r.interface_fraction);
   EXPECT_TRUE(finite(r.e));
   EXPECT_NEAR(r.K_energy / exact, 1.0, 0.06);
   EXPECT_NEAR(r.K_pressure / exact, 1.0, 0.06);
@@ -553,8 +579,8 @@ TEST(ValidationInterface, SphereInCubeBulkModulusCoarse) {
 void sphere_refinement(double inv) {
   const double exact = csa(1 / inv);
   const CubeRun c = run_cube(1 / inv, 0.1, 2, 0.015), f = run_cube(1 / inv, 0.05, 2, 0.015);
-  std::printf("[cube 1/D=%.0e] 100um: K_e %.1f K_p %.1f | 50um: K_e %.1f K_p %.1f | CSA %.1f\n", inv,
-              c.K_energy, c.K_pressure, f.K_energy, f.K_pressure, exact);
+  std::printf("[cube 1/D=%.0e] 100um: K_e %.1f K_p %.1f | 50um: K_e %.1f K_p %.1f | CSA %.1f\n",
+              inv, c.K_energy, c.K_pressure, f.K_energy, f.K_pressure, exact);
   EXPECT_NEAR(f.K_energy / exact, 1.0, 0.05) << "1/D = " << inv;
   EXPECT_NEAR(f.K_pressure / exact, 1.0, 0.05) << "1/D = " << inv;
   if (inv == 1e-4) {
@@ -573,7 +599,8 @@ TEST(ValidationInterfaceLong, SphereInCubeBulkModulusRefinement) {
 // docs/interface_validation.md, findings 1-2).
 TEST(ValidationInterfaceLong, SphereInCubeTransitionRegion) {
   MMPM_LONG_TEST();
-  MMPM_KNOWN_LIMITATION("force-limit switching at D A ~ 2 m_red / dt^2: K from energy 8.1 % high at 50 um");
+  MMPM_KNOWN_LIMITATION(
+      "force-limit switching at D A ~ 2 m_red / dt^2: K from energy 8.1 % high at 50 um");
   sphere_refinement(1e-6);
 }
 

@@ -28,7 +28,9 @@ inline void run_until(Simulation& sim, double t_end) {
 struct Column {
   std::vector<double> values;
   int components = 1;
-  double at(std::size_t p, int c = 0) const { return values[p * std::size_t(components) + std::size_t(c)]; }
+  double at(std::size_t p, int c = 0) const {
+    return values[p * std::size_t(components) + std::size_t(c)];
+  }
 };
 
 inline Column field(const Simulation& sim, const std::string& name) {
@@ -40,8 +42,8 @@ inline Column field(const Simulation& sim, const std::string& name) {
 
 // Long validation cases (refinement studies) run only under `ctest -L long`
 // (which sets MMPM_LONG=1); in CI they report as skipped.
-#define MMPM_LONG_TEST()                                                   \
-  do {                                                                     \
+#define MMPM_LONG_TEST()                                                           \
+  do {                                                                             \
     if (!std::getenv("MMPM_LONG")) GTEST_SKIP() << "long test: run ctest -L long"; \
   } while (0)
 

@@ -25,15 +25,18 @@ std::string build_description() {
 #endif
   os << "openmp: " << _OPENMP << ", max threads " << omp_get_max_threads() << "\n";
   os << "hardware threads: " << std::thread::hardware_concurrency() << "\n";
-  os << "eigen: " << EIGEN_WORLD_VERSION << "." << EIGEN_MAJOR_VERSION << "." << EIGEN_MINOR_VERSION << "\n";
+  os << "eigen: " << EIGEN_WORLD_VERSION << "." << EIGEN_MAJOR_VERSION << "." << EIGEN_MINOR_VERSION
+     << "\n";
   os << "tbb: " << TBB_VERSION_MAJOR << "." << TBB_VERSION_MINOR << "\n";
   unsigned maj = 0, min = 0, rel = 0;
   H5get_libversion(&maj, &min, &rel);
   os << "hdf5: " << maj << "." << min << "." << rel << "\n";
 #ifdef MMPM_FAST_DEV
-  os << "instantiations: 2D linear double, 2D gimp double/float, 3D gimp double (MMPM_FAST_DEV build)\n";
+  os << "instantiations: 2D linear double, 2D gimp double/float, 3D gimp double (MMPM_FAST_DEV "
+        "build)\n";
 #else
-  os << "instantiations: dimension {2,3} x shape {linear, gimp, bspline2, bspline3} x precision {double, float}\n";
+  os << "instantiations: dimension {2,3} x shape {linear, gimp, bspline2, bspline3} x precision "
+        "{double, float}\n";
 #endif
   return os.str();
 }

@@ -21,12 +21,14 @@ int check_scene(const std::string& file, const std::vector<std::string>& sets) {
   const double crit = critical_time_step(scene), dt = sim->dt();
   std::cout << "# instantiation: " << sim->instantiation() << "\n"
             << "# particles: " << sim->particle_count() << ", nodes: " << sim->node_count()
-            << ", material fields: " << sim->field_count() << ", tile: " << sim->tile_edge() << " cells\n"
-            << "# dt: " << dt << " (stability limit " << crit << ", cfl " << dt / crit << "), steps: "
-            << long(std::ceil(scene.simulation.end_time / dt - 1e-9)) << "\n";
+            << ", material fields: " << sim->field_count() << ", tile: " << sim->tile_edge()
+            << " cells\n"
+            << "# dt: " << dt << " (stability limit " << crit << ", cfl " << dt / crit
+            << "), steps: " << long(std::ceil(scene.simulation.end_time / dt - 1e-9)) << "\n";
   if (dt > crit * (1 + 1e-12))
-    std::cerr << file << ": warning: key 'simulation." << (scene.simulation.dt ? "dt" : "cfl")
-              << "': the time step exceeds the stability limit; `mmpm run` refuses it unless --force\n";
+    std::cerr
+        << file << ": warning: key 'simulation." << (scene.simulation.dt ? "dt" : "cfl")
+        << "': the time step exceeds the stability limit; `mmpm run` refuses it unless --force\n";
   return 0;
 }
 

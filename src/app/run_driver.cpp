@@ -47,27 +47,43 @@ std::string sanitize(std::string s) {
 }
 
 std::vector<std::string> series_names(const Simulation& sim) {
-  std::vector<std::string> n = {"time",     "step",          "kinetic", "strain", "interface",
-                                "external_work", "damping",  "kinetic_unresolved", "energy_balance",
-                                "kinetic_ratio", "stored_energy_residual"};
+  std::vector<std::string> n = {"time",
+                                "step",
+                                "kinetic",
+                                "strain",
+                                "interface",
+                                "external_work",
+                                "damping",
+                                "kinetic_unresolved",
+                                "energy_balance",
+                                "kinetic_ratio",
+                                "stored_energy_residual"};
   const int dim = sim.snapshot({}).dimension;
   for (const auto& r : sim.reactions())
     for (int d = 0; d < dim; ++d) n.push_back(sanitize("reaction_" + r.name + "_" + kAxes[d]));
-  for (const char* c : {"multimaterial_nodes", "nodes_3plus", "force_limited_nodes"}) n.push_back(c);
+  for (const char* c : {"multimaterial_nodes", "nodes_3plus", "force_limited_nodes"})
+    n.push_back(c);
   for (const char* s : kStageNames) n.push_back(std::string("stage_") + s + "_s");
   return n;
 }
 
-void add_series_row(Simulation& sim, DriverState& st, const std::array<double, kStageCount>& stage_s,
-                    int dim) {
+void add_series_row(Simulation& sim, DriverState& st,
+                    const std::array<double, kStageCount>& stage_s, int dim) {
   const Energies e = sim.energies();
   // energy_balance: energy now (incl. what damping removed) minus the
   // initial energy and the external work; zero for an exact integrator.
   const double total = e.kinetic + e.strain + e.interface + e.damping;
-  const double initial = st.columns.empty() ? total - e.external_work
-                                            : st.columns[2][0] + st.columns[3][0] + st.columns[4][0];
-  std::vector<double> row = {sim.time(), double(sim.step_count()), e.kinetic, e.strain, e.interface,
-                             e.external_work, e.damping, e.kinetic_unresolved,
+  const double initial = st.columns.empty()
+                             ? total - e.external_work
+                             : st.columns[2][0] + st.columns[3][0] + st.columns[4][0];
+  std::vector<double> row = {sim.time(),
+                             double(sim.step_count()),
+                             e.kinetic,
+                             e.strain,
+                             e.interface,
+                             e.external_work,
+                             e.damping,
+                             e.kinetic_unresolved,
                              total - e.external_work - initial};
   // Convergence monitor for static runs: kinetic / stored energy, and the
   // relative change of the stored energy over the last kResidualWindow rows.
@@ -103,7 +119,8 @@ std::vector<io::Blob> driver_blobs(const DriverState& st) {
 void load_driver_blobs(const std::vector<io::Blob>& blobs, DriverState& st) {
   st.next_snapshot = io::read_scalar_blob<long>(io::find_blob(blobs, "driver.next_snapshot"));
   st.streak_start = io::read_scalar_blob<long>(io::find_blob(blobs, "driver.streak_start"));
-  st.last_snapshot_step = io::read_scalar_blob<long>(io::find_blob(blobs, "driver.last_snapshot_step"));
+  st.last_snapshot_step =
+      io::read_scalar_blob<long>(io::find_blob(blobs, "driver.last_snapshot_step"));
   st.columns.assign(st.names.size(), {});
   for (std::size_t k = 0; k < st.names.size(); ++k)
     io::read_blob(io::find_blob(blobs, "driver.series." + std::to_string(k)), st.columns[k]);
@@ -111,7 +128,8 @@ void load_driver_blobs(const std::vector<io::Blob>& blobs, DriverState& st) {
 
 class Progress {
  public:
-  Progress(bool on, double end_time) : on_(on), end_(end_time), start_(Clock::now()), last_(start_) {}
+  Progress(bool on, double end_time)
+      : on_(on), end_(end_time), start_(Clock::now()), last_(start_) {}
   void update(long step, double t, bool force = false) {
     if (!on_) return;
     const auto now = Clock::now();
@@ -120,8 +138,11 @@ class Progress {
     const double el = std::chrono::duration<double>(now - start_).count();
     const double rate = el > 0 ? double(step - first_step_) / el : 0.0;
     const double frac = end_ > 0 ? t / end_ : 0.0;
-    const double eta = frac > 0 && frac < 1 && el > 0 ? el * (1 - frac) / std::max(1e-12, frac - first_frac_) : 0.0;
-    std::fprintf(stderr, "\rstep %9ld  t = %.6g / %.6g  %9.0f steps/s  ETA %7.1f s   ", step, t, end_, rate, eta);
+    const double eta = frac > 0 && frac < 1 && el > 0
+                           ? el * (1 - frac) / std::max(1e-12, frac - first_frac_)
+                           : 0.0;
+    std::fprintf(stderr, "\rstep %9ld  t = %.6g / %.6g  %9.0f steps/s  ETA %7.1f s   ", step, t,
+                 end_, rate, eta);
     std::fflush(stderr);
   }
   void start_at(long step, double t) {
@@ -220,7 +241,9 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
   }
   std::string stopped_by = "end_time";
   const long series_every = std::max(1, o.series);
-  const long stop_check = scene.stop.enabled ? std::max(1L, std::min<long>(series_every, scene.stop.hold_steps / 4)) : 0;
+  const long stop_check =
+      scene.stop.enabled ? std::max(1L, std::min<long>(series_every, scene.stop.hold_steps / 4))
+                         : 0;
   const double ckpt_s = o.checkpoint_minutes * 60.0;
   auto last_ckpt = Clock::now();
   try {
@@ -295,8 +318,11 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
   }
   js["other"] = wall - timed;
   j["stages_s"] = js;
-  j["energy"] = {{"kinetic", e.kinetic}, {"strain", e.strain}, {"interface", e.interface},
-                 {"external_work", e.external_work}, {"damping", e.damping}};
+  j["energy"] = {{"kinetic", e.kinetic},
+                 {"strain", e.strain},
+                 {"interface", e.interface},
+                 {"external_work", e.external_work},
+                 {"damping", e.damping}};
   j["multimaterial_nodes"] = c.multimaterial_nodes;
   j["nodes_3plus"] = c.nodes_3plus;
   j["force_limited_nodes"] = c.force_limited_nodes;
@@ -322,7 +348,8 @@ RunOutcome run_scene(const Scene& scene, const RunOptions& options, std::ostream
 
 RunOutcome restart_run(const fs::path& dir, const RunOptions& options, std::ostream& log) {
   const fs::path scene_file = dir / "scene.toml";
-  if (!fs::exists(scene_file)) throw InputError(scene_file.string() + ": no resolved scene to restart from");
+  if (!fs::exists(scene_file))
+    throw InputError(scene_file.string() + ": no resolved scene to restart from");
   const fs::path ckpt = dir / "checkpoint.bin";
   if (!fs::exists(ckpt)) throw InputError(ckpt.string() + ": no checkpoint to restart from");
   Scene scene = parse_scene_file(scene_file.string());

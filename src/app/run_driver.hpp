@@ -4,10 +4,9 @@
 
 #include <filesystem>
 #include <iosfwd>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 #include "scene/scene.hpp"
 
@@ -17,15 +16,15 @@ struct RunOptions {
   std::filesystem::path out;  // empty: scene.output.directory
   int threads = 0;            // 0: OpenMP default
   bool quiet = false;
-  bool force = false;         // run even above the stability limit
-  bool progress = true;       // progress line when stderr is a terminal
+  bool force = false;    // run even above the stability limit
+  bool progress = true;  // progress line when stderr is a terminal
   bool timing_table = true;
 };
 
 struct RunOutcome {
-  int exit_code = 0;          // 0 ok, 2 bad input, 3 unstable / failed
-  std::string message;        // error text when exit_code != 0
-  nlohmann::json summary;     // summary.json contents when the run completed
+  int exit_code = 0;       // 0 ok, 2 bad input, 3 unstable / failed
+  std::string message;     // error text when exit_code != 0
+  nlohmann::json summary;  // summary.json contents when the run completed
   std::filesystem::path directory;
 };
 

@@ -55,7 +55,8 @@ int run_sweep(const SweepOptions& opt) {
     ov.push_back(opt.param + "=" + v);
     scenes.push_back(parse_scene_file(opt.scene_file, ov));
   }
-  const fs::path dir = opt.out.empty() ? fs::path("results") / (scenes.front().name + "_sweep") : opt.out;
+  const fs::path dir =
+      opt.out.empty() ? fs::path("results") / (scenes.front().name + "_sweep") : opt.out;
   fs::create_directories(dir);
   const int jobs = std::max(1, std::min<int>(opt.jobs, int(n)));
   const int cores = int(std::max(1u, std::thread::hardware_concurrency()));
@@ -90,14 +91,16 @@ int run_sweep(const SweepOptions& opt) {
   int code = 0;
   for (std::size_t k = 0; k < n; ++k) {
     const auto& r = results[k];
-    csv << k << "," << csv_quoted(opt.values[k]) << "," << (r.exit_code == 0 ? "ok" : "failed") << ",";
+    csv << k << "," << csv_quoted(opt.values[k]) << "," << (r.exit_code == 0 ? "ok" : "failed")
+        << ",";
     if (r.exit_code == 0) {
       const auto& j = r.summary;
       const auto& e = j["energy"];
-      csv << j["steps"] << "," << j["end_time"] << "," << j["wall_s"] << "," << j["ns_per_particle_step"]
-          << "," << e["kinetic"] << "," << e["strain"] << "," << e["interface"] << "," << e["external_work"]
-          << "," << e["damping"] << "," << j["multimaterial_nodes"] << "," << j["force_limited_nodes"]
-          << "," << j["stopped_by"].get<std::string>();
+      csv << j["steps"] << "," << j["end_time"] << "," << j["wall_s"] << ","
+          << j["ns_per_particle_step"] << "," << e["kinetic"] << "," << e["strain"] << ","
+          << e["interface"] << "," << e["external_work"] << "," << e["damping"] << ","
+          << j["multimaterial_nodes"] << "," << j["force_limited_nodes"] << ","
+          << j["stopped_by"].get<std::string>();
     } else {
       csv << ",,,,,,,,,,,," << csv_quoted(r.message.substr(0, 200));
       code = 3;

@@ -123,7 +123,8 @@ std::vector<Blob> read_checkpoint(const std::filesystem::path& file) {
     corrupt(file, "checksum mismatch");
   }
   if (reader.position() != bytes.size()) {
-    corrupt(file, std::to_string(bytes.size() - reader.position()) + " stray bytes after the checksum");
+    corrupt(file,
+            std::to_string(bytes.size() - reader.position()) + " stray bytes after the checksum");
   }
   return blobs;
 }

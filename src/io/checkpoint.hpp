@@ -42,10 +42,9 @@ Blob make_blob(std::string name, const std::vector<T>& values) {
 template <BlobElement T>
 void read_blob(const Blob& blob, std::vector<T>& values) {
   if (blob.bytes.size() % sizeof(T) != 0) {
-    throw std::runtime_error("checkpoint blob '" + blob.name + "': " +
-                             std::to_string(blob.bytes.size()) +
-                             " bytes is not a whole number of " + std::to_string(sizeof(T)) +
-                             "-byte elements");
+    throw std::runtime_error(
+        "checkpoint blob '" + blob.name + "': " + std::to_string(blob.bytes.size()) +
+        " bytes is not a whole number of " + std::to_string(sizeof(T)) + "-byte elements");
   }
   values.resize(blob.bytes.size() / sizeof(T));
   if (!values.empty()) std::memcpy(values.data(), blob.bytes.data(), blob.bytes.size());

@@ -57,7 +57,9 @@ void check(herr_t status, const std::string& what) {
   if (status < 0) raise(what);
 }
 
-std::string quoted(const std::string& name) { return "'" + name + "'"; }
+std::string quoted(const std::string& name) {
+  return "'" + name + "'";
+}
 
 // A name this layer creates must be one link, not a path: it keeps the
 // wrappers' meaning obvious and HDF5's "." and ".." out of the way.
@@ -73,8 +75,8 @@ Id make_space(const std::vector<hsize_t>& shape, std::size_t values) {
   const hsize_t n = std::accumulate(shape.begin(), shape.end(), hsize_t{1},
                                     [](hsize_t a, hsize_t b) { return a * b; });
   if (n != values) {
-    throw std::invalid_argument("HDF5 dataset: shape holds " + std::to_string(n) +
-                                " values but " + std::to_string(values) + " were given");
+    throw std::invalid_argument("HDF5 dataset: shape holds " + std::to_string(n) + " values but " +
+                                std::to_string(values) + " were given");
   }
   return Id(check_id(H5Screate_simple(static_cast<int>(shape.size()), shape.data(), nullptr),
                      "cannot create a dataspace"),
@@ -149,7 +151,8 @@ void raise(const std::string& what) {
 // ---- Id ----
 
 Id::Id(Id&& other) noexcept
-    : id_(std::exchange(other.id_, H5I_INVALID_HID)), closer_(std::exchange(other.closer_, nullptr)) {}
+    : id_(std::exchange(other.id_, H5I_INVALID_HID)),
+      closer_(std::exchange(other.closer_, nullptr)) {}
 
 Id& Id::operator=(Id&& other) noexcept {
   if (this != &other) {
@@ -181,9 +184,9 @@ void Id::close(const std::string& what) {
 
 Attribute Attribute::open(hid_t object, const std::string& name) {
   Guard guard;
-  return Attribute(Id(check_id(H5Aopen(object, name.c_str(), H5P_DEFAULT),
-                               "cannot open attribute " + quoted(name)),
-                      H5Aclose));
+  return Attribute(Id(
+      check_id(H5Aopen(object, name.c_str(), H5P_DEFAULT), "cannot open attribute " + quoted(name)),
+      H5Aclose));
 }
 
 Attribute Attribute::create(hid_t object, const std::string& name, hid_t file_type, hid_t space) {
@@ -191,11 +194,12 @@ Attribute Attribute::create(hid_t object, const std::string& name, hid_t file_ty
   if (name.empty()) throw std::invalid_argument("HDF5 attribute name must not be empty");
   const htri_t exists = H5Aexists(object, name.c_str());
   if (exists < 0) raise("cannot look up attribute " + quoted(name));
-  if (exists > 0) check(H5Adelete(object, name.c_str()), "cannot replace attribute " + quoted(name));
-  return Attribute(Id(check_id(H5Acreate2(object, name.c_str(), file_type, space, H5P_DEFAULT,
-                                          H5P_DEFAULT),
-                               "cannot create attribute " + quoted(name)),
-                      H5Aclose));
+  if (exists > 0)
+    check(H5Adelete(object, name.c_str()), "cannot replace attribute " + quoted(name));
+  return Attribute(
+      Id(check_id(H5Acreate2(object, name.c_str(), file_type, space, H5P_DEFAULT, H5P_DEFAULT),
+                  "cannot create attribute " + quoted(name)),
+         H5Aclose));
 }
 
 // ---- Object ----
@@ -305,9 +309,9 @@ Group Group::create_group(const std::string& name) {
 
 Group Group::open_group(const std::string& name) const {
   Guard guard;
-  return Group(Id(check_id(H5Gopen2(id(), name.c_str(), H5P_DEFAULT),
-                           "cannot open group " + quoted(name)),
-                  H5Gclose));
+  return Group(
+      Id(check_id(H5Gopen2(id(), name.c_str(), H5P_DEFAULT), "cannot open group " + quoted(name)),
+         H5Gclose));
 }
 
 Group Group::require_group(const std::string& name) {
@@ -364,9 +368,9 @@ Dataset Group::write_ints(const std::string& name, std::span<const std::int64_t>
 
 Dataset Group::open_dataset(const std::string& name) const {
   Guard guard;
-  return Dataset(Id(check_id(H5Dopen2(id(), name.c_str(), H5P_DEFAULT),
-                             "cannot open dataset " + quoted(name)),
-                    H5Dclose));
+  return Dataset(
+      Id(check_id(H5Dopen2(id(), name.c_str(), H5P_DEFAULT), "cannot open dataset " + quoted(name)),
+         H5Dclose));
 }
 
 // ---- File ----
@@ -376,8 +380,7 @@ namespace {
 // Lock the file against a second writer where the file system allows it, and
 // carry on without a lock where it does not (some network file systems).
 Id access_properties() {
-  Id fapl(check_id(H5Pcreate(H5P_FILE_ACCESS), "cannot create file access properties"),
-          H5Pclose);
+  Id fapl(check_id(H5Pcreate(H5P_FILE_ACCESS), "cannot create file access properties"), H5Pclose);
   check(H5Pset_file_locking(fapl.get(), true, true), "cannot set file locking");
   return fapl;
 }
@@ -417,6 +420,8 @@ void File::flush() {
   check(H5Fflush(id_.get(), H5F_SCOPE_GLOBAL), "cannot flush " + quoted(path_.string()));
 }
 
-void File::close() { id_.close("cannot close HDF5 file " + quoted(path_.string())); }
+void File::close() {
+  id_.close("cannot close HDF5 file " + quoted(path_.string()));
+}
 
 }  // namespace mmpm::io::h5

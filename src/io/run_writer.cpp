@@ -42,7 +42,9 @@ long parse_step_name(const std::string& name) {
   return step;
 }
 
-std::string vertices_name(std::size_t count) { return "vertices_" + std::to_string(count); }
+std::string vertices_name(std::size_t count) {
+  return "vertices_" + std::to_string(count);
+}
 
 // "/a/b/c" from {"a", "b", "c"}. (Built by appending: GCC 12 at -O3 gives a
 // false -Wrestrict on `"/" + std::string(...)`.)
@@ -86,9 +88,12 @@ void check_snapshot(const Snapshot& s) {
   std::set<std::string> names;
   for (const ParticleField& f : s.fields) {
     check_name(f.name, "particle field");
-    if (f.name == "position") throw std::invalid_argument(where + "a field may not be called 'position'");
-    if (!names.insert(f.name).second) throw std::invalid_argument(where + "field '" + f.name + "' given twice");
-    if (f.components < 1) throw std::invalid_argument(where + "field '" + f.name + "' needs >= 1 component");
+    if (f.name == "position")
+      throw std::invalid_argument(where + "a field may not be called 'position'");
+    if (!names.insert(f.name).second)
+      throw std::invalid_argument(where + "field '" + f.name + "' given twice");
+    if (f.components < 1)
+      throw std::invalid_argument(where + "field '" + f.name + "' needs >= 1 component");
     const std::size_t expected = s.count * static_cast<std::size_t>(f.components);
     if (f.values.size() != expected) {
       throw std::invalid_argument(where + "field '" + f.name + "' holds " +
@@ -168,8 +173,10 @@ std::vector<XdmfSnapshot> describe(const h5::Group& root) {
     const h5::Group group = particles.open_group(name);
     const std::vector<hsize_t> shape = group.open_dataset("position").shape();
     if (shape.size() != 2) throw std::runtime_error("run file: " + name + "/position is not 2-D");
-    XdmfSnapshot s{group.int_attribute("step"), group.double_attribute("time"),
-                   static_cast<int>(shape[1]), static_cast<std::size_t>(shape[0]),
+    XdmfSnapshot s{group.int_attribute("step"),
+                   group.double_attribute("time"),
+                   static_cast<int>(shape[1]),
+                   static_cast<std::size_t>(shape[0]),
                    absolute({particles_group, name, "position"}),
                    absolute({xdmf_group, vertices_name(static_cast<std::size_t>(shape[0]))}),
                    {}};
@@ -224,8 +231,8 @@ RunWriter RunWriter::reopen(const fs::path& dir, long last_step) {
   if (!fs::exists(partial)) {
     throw std::runtime_error("cannot restart: " + partial.string() + " does not exist");
   }
-  RunWriter writer(
-      dir, std::make_unique<h5::File>(h5::File::open(partial, h5::File::Mode::read_write)));
+  RunWriter writer(dir,
+                   std::make_unique<h5::File>(h5::File::open(partial, h5::File::Mode::read_write)));
   h5::Group root = writer.file_->root();
   for (const char* group_name : {particles_group, xdmf_group}) {
     if (!root.contains(group_name)) continue;
@@ -252,7 +259,9 @@ RunWriter& RunWriter::operator=(RunWriter&& other) noexcept {
   return *this;
 }
 
-RunWriter::~RunWriter() { close_quietly(); }
+RunWriter::~RunWriter() {
+  close_quietly();
+}
 
 void RunWriter::close_quietly() noexcept {
   if (!is_open()) return;
@@ -263,7 +272,9 @@ void RunWriter::close_quietly() noexcept {
   }
 }
 
-bool RunWriter::is_open() const { return file_ != nullptr && file_->valid(); }
+bool RunWriter::is_open() const {
+  return file_ != nullptr && file_->valid();
+}
 
 void RunWriter::require_open(const char* operation) const {
   if (!is_open()) {

@@ -12,12 +12,23 @@ std::string escaped(const std::string& text) {
   std::string out;
   for (const char c : text) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&apos;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -34,10 +45,14 @@ std::string exact(double value) {
 
 const char* kind_name(AttributeKind kind) {
   switch (kind) {
-    case AttributeKind::scalar: return "Scalar";
-    case AttributeKind::vector: return "Vector";
-    case AttributeKind::tensor: return "Tensor";
-    case AttributeKind::matrix: return "Matrix";
+    case AttributeKind::scalar:
+      return "Scalar";
+    case AttributeKind::vector:
+      return "Vector";
+    case AttributeKind::tensor:
+      return "Tensor";
+    case AttributeKind::matrix:
+      return "Matrix";
   }
   return "Matrix";
 }
@@ -72,7 +87,8 @@ std::string xdmf_document(const std::string& h5_file, const std::vector<XdmfSnap
     }
     const std::string in = "        ";
     out << "      <Grid Name=\"step_" << s.step << "\" GridType=\"Uniform\">\n"
-        << in << "<Time Value=\"" << exact(s.time) << "\"/>\n"
+        << in << "<Time Value=\"" << exact(s.time)
+        << "\"/>\n"
         // One vertex cell per particle, with explicit connectivity: readers
         // differ on what an implicit Polyvertex topology means.
         << in << "<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" << s.count

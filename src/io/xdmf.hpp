@@ -26,23 +26,24 @@ AttributeKind attribute_kind(int components, int dimension);
 struct XdmfField {
   std::string name;
   AttributeKind kind;
-  std::string dataset;     // path inside the HDF5 file, e.g. /particles/step_0000000010/velocity
-  int stored_components;   // columns of that dataset (3 for a padded 2D vector)
+  std::string dataset;    // path inside the HDF5 file, e.g. /particles/step_0000000010/velocity
+  int stored_components;  // columns of that dataset (3 for a padded 2D vector)
 };
 
 struct XdmfSnapshot {
   long step;
   double time;
-  int dimension;                // 2 or 3
-  std::size_t count;            // particles
-  std::string position;         // dataset [count x dimension]
-  std::string connectivity;     // dataset [count] of 0..count-1 (one vertex cell per particle)
+  int dimension;             // 2 or 3
+  std::size_t count;         // particles
+  std::string position;      // dataset [count x dimension]
+  std::string connectivity;  // dataset [count] of 0..count-1 (one vertex cell per particle)
   std::vector<XdmfField> fields;
 };
 
 // The whole XDMF 3 document: one temporal collection of Polyvertex grids,
 // datasets referenced as "H5_FILE_NAME:/path" (relative, so the pair of files
 // can be moved together).
-std::string xdmf_document(const std::string& h5_file_name, const std::vector<XdmfSnapshot>& snapshots);
+std::string xdmf_document(const std::string& h5_file_name,
+                          const std::vector<XdmfSnapshot>& snapshots);
 
 }  // namespace mmpm::io

@@ -27,7 +27,8 @@ Vec3 to_body_frame(const BodySpec& b, const Vec3& x) {
   const Vec3 c = box_center(b);
   const double a = -b.rotate * std::numbers::pi / 180.0;
   const double dx = x[0] - c[0], dy = x[1] - c[1];
-  return {c[0] + std::cos(a) * dx - std::sin(a) * dy, c[1] + std::sin(a) * dx + std::cos(a) * dy, x[2]};
+  return {c[0] + std::cos(a) * dx - std::sin(a) * dy, c[1] + std::sin(a) * dx + std::cos(a) * dy,
+          x[2]};
 }
 
 Vec3 rotate_vector(const BodySpec& b, const Vec3& v) {
@@ -106,7 +107,8 @@ bool inside_body(const BodySpec& b, const Vec3& x, int dim) {
       return r2 <= b.radius * b.radius;
     }
     case BodyShape::cylinder: {
-      const double r2 = (x[0] - b.center[0]) * (x[0] - b.center[0]) + (x[1] - b.center[1]) * (x[1] - b.center[1]);
+      const double r2 =
+          (x[0] - b.center[0]) * (x[0] - b.center[0]) + (x[1] - b.center[1]) * (x[1] - b.center[1]);
       return r2 <= b.radius * b.radius && x[2] >= b.center[2] && x[2] <= b.center[2] + b.length;
     }
     case BodyShape::polygon: {
@@ -171,8 +173,9 @@ ParticleSeeds make_particles(const Scene& scene) {
               }
     if (added == 0)
       throw InputError(located(body.where.file, body.where.line, "shape",
-                               "body '" + body.name + "' holds no particle on this grid "
-                               "(smaller than a particle spacing, or outside the grid)"));
+                               "body '" + body.name +
+                                   "' holds no particle on this grid "
+                                   "(smaller than a particle spacing, or outside the grid)"));
   }
   // Drop replaced particles, keeping the order.
   std::size_t w = 0;

@@ -13,8 +13,8 @@ namespace mmpm {
 struct ParticleSeeds {
   std::vector<Vec3> x;
   std::vector<Vec3> v;
-  std::vector<double> volume;   // area * thickness in 2D
-  std::vector<Vec3> half_width; // uGIMP half-width in cell units per direction
+  std::vector<double> volume;    // area * thickness in 2D
+  std::vector<Vec3> half_width;  // uGIMP half-width in cell units per direction
   std::vector<int> material;
   std::vector<int> body;
   std::vector<Vec3> traction_force;  // external force on the particle (before the ramp)

@@ -34,7 +34,8 @@ Mat6 rotate_stiffness(const Mat6& C, const Eigen::Matrix3d& R) {
           for (int a = 0; a < 3; ++a)
             for (int b = 0; b < 3; ++b)
               for (int e = 0; e < 3; ++e)
-                for (int d = 0; d < 3; ++d) s += R(a, i) * R(b, j) * R(e, k) * R(d, l) * c[a][b][e][d];
+                for (int d = 0; d < 3; ++d)
+                  s += R(a, i) * R(b, j) * R(e, k) * R(d, l) * c[a][b][e][d];
           out(voigt(i, j), voigt(k, l)) = s;
         }
   return out;
@@ -64,7 +65,8 @@ Mat6 transverse_compliance(const MaterialSpec& m) {
 Eigen::Matrix3d frame_from_axis(const Vec3& axis_in) {
   Eigen::Vector3d a(axis_in[0], axis_in[1], axis_in[2]);
   a.normalize();
-  Eigen::Vector3d helper = std::abs(a.z()) < 0.9 ? Eigen::Vector3d(0, 0, 1) : Eigen::Vector3d(1, 0, 0);
+  Eigen::Vector3d helper =
+      std::abs(a.z()) < 0.9 ? Eigen::Vector3d(0, 0, 1) : Eigen::Vector3d(1, 0, 0);
   Eigen::Vector3d b = helper.cross(a).normalized();
   Eigen::Vector3d c = a.cross(b);
   Eigen::Matrix3d R;

@@ -56,7 +56,8 @@ std::vector<BoundaryNodes> resolve_boundaries(const Scene& scene) {
       if (on) b.nodes.push_back(std::uint32_t(i));
     }
     if (b.nodes.empty())
-      throw InputError(located(spec.where.file, spec.where.line, "where", "no grid node lies in this boundary"));
+      throw InputError(
+          located(spec.where.file, spec.where.line, "where", "no grid node lies in this boundary"));
     out.push_back(std::move(b));
   }
   return out;

@@ -91,9 +91,11 @@ FieldPlan plan_fields(const Scene& scene) {
     for (std::size_t b = 0; b < F; ++b) {
       const int l = plan.pair[a * F + b];
       if (l < 0 || a == b) continue;
-      if (plan.laws[std::size_t(l)].normal == NormalMethod::rigid && !plan.rigid[a] && !plan.rigid[b]) {
+      if (plan.laws[std::size_t(l)].normal == NormalMethod::rigid && !plan.rigid[a] &&
+          !plan.rigid[b]) {
         const auto& w = plan.laws[std::size_t(l)].where;
-        throw InputError(located(w.file, w.line, "normal", "\"rigid\" needs one rigid material in the pair"));
+        throw InputError(
+            located(w.file, w.line, "normal", "\"rigid\" needs one rigid material in the pair"));
       }
     }
   return plan;

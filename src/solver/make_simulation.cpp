@@ -1,7 +1,7 @@
 // Picks the compiled instantiation (dimension × shape × precision) for a scene.
+#include "scene/error.hpp"
 #include "solver/instantiations.hpp"
 #include "solver/simulation.hpp"
-#include "scene/error.hpp"
 
 namespace mmpm {
 
@@ -11,9 +11,12 @@ std::unique_ptr<Simulation> make_simulation(const Scene& scene) {
   const ShapeKind s = scene.grid.shape;
 #ifdef MMPM_FAST_DEV
   if (d == 2 && s == ShapeKind::linear && dbl) return make_stepper_2_linear_double(scene);
-  if (d == 2 && s == ShapeKind::gimp) return dbl ? make_stepper_2_gimp_double(scene) : make_stepper_2_gimp_float(scene);
+  if (d == 2 && s == ShapeKind::gimp)
+    return dbl ? make_stepper_2_gimp_double(scene) : make_stepper_2_gimp_float(scene);
   if (d == 3 && s == ShapeKind::gimp && dbl) return make_stepper_3_gimp_double(scene);
-  throw InputError(scene.source_file + ": this developer build (MMPM_FAST_DEV) lacks the instantiation the scene needs");
+  throw InputError(
+      scene.source_file +
+      ": this developer build (MMPM_FAST_DEV) lacks the instantiation the scene needs");
 #else
 #define MMPM_PICK(DIM, SHAPE, KIND)                           \
   if (d == DIM && s == ShapeKind::KIND)                       \
