@@ -56,6 +56,9 @@ void register_step_pair();
 // `cells` x `cells` cells, 2 x 2 particles per cell, in a grid 4 cells wider.
 // bench_step.cpp's 2d_linear_1mat is linear_block_scene(250).
 std::string linear_block_scene(int cells);
+// The stages' names in counter names (Simulation's kStageNames, with "mm"
+// for the multimaterial stage; bench_step.cpp); bench/table.py reads them.
+const char* bench_stage_name(int stage);
 // Per-stage counters stage_<name>_ns_per_particle from two stage_seconds()
 // readings (bench_step.cpp); returns the per-stage seconds between them.
 std::array<double, 7> set_stage_counters(benchmark::State& state,

@@ -28,6 +28,7 @@
 // traction, so the step does its full work; motions stay small, so the
 // default re-binning rarely triggers.
 #include <algorithm>
+#include <iterator>
 #include <map>
 #include <stdexcept>
 
@@ -278,17 +279,22 @@ StepCase shared_case(const std::string& scene) {
 
 }  // namespace
 
+const char* bench_stage_name(int stage) {
+  static const char* const names[] = {"sort", "p2g", "mm", "grid", "g2p", "constitutive", "output"};
+  static_assert(std::size(names) == kStageCount);
+  return names[stage];
+}
+
 std::array<double, 7> set_stage_counters(benchmark::State& state,
                                          const std::array<double, 7>& before,
                                          const std::array<double, 7>& after, double steps,
                                          double particles) {
   static_assert(kStageCount == 7);
-  const char* names[kStageCount] = {"sort", "p2g", "mm", "grid", "g2p", "constitutive", "output"};
   std::array<double, kStageCount> ds{};
   for (int s = 0; s < kStageCount; ++s) {
     ds[s] = after[s] - before[s];
     if (s != kStageOutput)
-      state.counters[std::string("stage_") + names[s] + "_ns_per_particle"] =
+      state.counters[std::string("stage_") + bench_stage_name(s) + "_ns_per_particle"] =
           ds[s] * 1e9 / (steps * particles);
   }
   return ds;
