@@ -101,10 +101,12 @@ void update_deformable(const GridView<D, Real>& G, const GridVelocity<D, Real>& 
 // p <- p + dt (f + f_interface + m g - alpha p); stores -v_old in dvel
 // (with q.velocities: also vel, and dvel = v_new - v_old). Returns the
 // energy removed by grid damping this step (deterministic sum).
-// Each thread updates the nodes it owns (kernels/node_ownership.hpp).
-template <int D, class Real>
+// Each thread updates the nodes it owns (kernels/node_ownership.hpp), then
+// calls after(f, first, last) on each range of field f it updated (the
+// supports, kernels/supports.hpp), in the same parallel region.
+template <int D, class Real, class After = NoNodeHook>
 double grid_update(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
-                   const GridUpdateParams& q, const NodeOwnership& own = {}) {
+                   const GridUpdateParams& q, const NodeOwnership& own = {}, After&& after = {}) {
   const Real dt = Real(q.dt), alpha = Real(q.damping), thr = Real(q.mass_threshold);
   auto body = [&](int f, std::size_t b, std::size_t e, std::array<double, 1>& acc) {
     const std::size_t o = std::size_t(f) * G.nodes;
@@ -151,8 +153,12 @@ double grid_update(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
     if (damping)
       for (std::size_t n = 0; n < e - b; ++n) acc[0] += double(alpha) * double(dt) * pv[n];
   };
+  auto update_then_hook = [&](int f, std::size_t b, std::size_t e, std::array<double, 1>& acc) {
+    body(f, b, e, acc);
+    after(f, b, e);
+  };
   double loss = 0;
-  for (const auto& field_loss : owned_field_sums<1>(own, G.nodes, G.fields, body))
+  for (const auto& field_loss : owned_field_sums<1>(own, G.nodes, G.fields, update_then_hook))
     loss += field_loss[0];
   return loss;
 }
@@ -164,18 +170,19 @@ namespace detail {
 // restrict pointers, so the compiler vectorises it (the branchy loops ran
 // scalar). Every node computes its quotient (m = 0 gives 0/0 or inf, which
 // the select drops).
-template <bool CompleteDvel, int D, class Real>
+template <bool CompleteDvel, int D, class Real, class After>
 void node_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V, Real thr,
-                     const NodeOwnership& own) {
+                     const NodeOwnership& own, After& after) {
 #pragma omp parallel if (G.nodes * std::size_t(G.fields) >= kParallelMin)
-  for_own_nodes(own, G.nodes, G.fields, [&](std::size_t b, std::size_t e) {
+  for_own_field_nodes(own, G.nodes, G.fields, [&](int f, std::size_t first, std::size_t last) {
+    const std::size_t o = std::size_t(f) * G.nodes;
     const Real* __restrict m_ = G.m;
     const Real* __restrict p_[D];
     Real* __restrict vel_[D];
     Real* __restrict dv_[D];
     for (int d = 0; d < D; ++d) p_[d] = G.p[d], vel_[d] = V.vel[d], dv_[d] = V.dvel[d];
 #pragma GCC ivdep
-    for (std::size_t i = b; i < e; ++i) {
+    for (std::size_t i = o + first; i < o + last; ++i) {
       const Real m = m_[i];
       const bool heavy = m > thr;
       if constexpr (CompleteDvel) {
@@ -193,6 +200,7 @@ void node_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
         }
       }
     }
+    after(f, first, last);
   });
 }
 
@@ -200,10 +208,11 @@ void node_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
 
 // vel = p/m, dvel += vel (completing v_new - v_old), after pass B; nodes
 // with a sliver of mass keep vel = 0 and the increment grid_update gave them.
-template <int D, class Real>
+// Then after(f, first, last) on each range, as grid_update.
+template <int D, class Real, class After = NoNodeHook>
 void grid_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V, Real thr,
-                     const NodeOwnership& own = {}) {
-  detail::node_velocities<true>(G, V, thr, own);
+                     const NodeOwnership& own = {}, After&& after = {}) {
+  detail::node_velocities<true>(G, V, thr, own, after);
 }
 
 // vel = p/m alone (dvel untouched): the velocities of re-extrapolated
@@ -211,10 +220,10 @@ void grid_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
 // quotient is p/m as the Stepper's scalar loop computed it (bitwise), in a
 // loop that now vectorises (docs/performance.md "Loops the compiler
 // vectorises").
-template <int D, class Real>
+template <int D, class Real, class After = NoNodeHook>
 void grid_momentum_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V, Real thr,
-                              const NodeOwnership& own = {}) {
-  detail::node_velocities<false>(G, V, thr, own);
+                              const NodeOwnership& own = {}, After&& after = {}) {
+  detail::node_velocities<false>(G, V, thr, own, after);
 }
 
 }  // namespace mmpm

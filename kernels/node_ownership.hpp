@@ -97,14 +97,28 @@ NodeOwnership node_ownership(const TileLayout<D>& layout, const std::array<int, 
   return own;
 }
 
-// body(first, last) over the calling thread's own nodes of every field, as
-// flat (field, node) indices; call inside a parallel region.
+// body(f, first, last) on the calling thread's nodes [first, last) of each
+// field f (indices within the field); call inside a parallel region.
 template <class Body>
-inline void for_own_nodes(const NodeOwnership& own, std::size_t nodes, int fields, Body&& body) {
+inline void for_own_field_nodes(const NodeOwnership& own, std::size_t nodes, int fields,
+                                Body&& body) {
   const auto [b, e] = own.mine(nodes);
   if (b >= e) return;
-  for (int f = 0; f < fields; ++f) body(std::size_t(f) * nodes + b, std::size_t(f) * nodes + e);
+  for (int f = 0; f < fields; ++f) body(f, b, e);
 }
+
+// As for_own_field_nodes, with flat (field, node) indices: body(first, last).
+template <class Body>
+inline void for_own_nodes(const NodeOwnership& own, std::size_t nodes, int fields, Body&& body) {
+  for_own_field_nodes(own, nodes, fields, [&](int f, std::size_t b, std::size_t e) {
+    body(std::size_t(f) * nodes + b, std::size_t(f) * nodes + e);
+  });
+}
+
+// A node-range hook that does nothing (the default `after` of the node passes).
+struct NoNodeHook {
+  void operator()(int, std::size_t, std::size_t) const {}
+};
 
 // Arrays of fields x nodes set to zero, each thread its own nodes, in one
 // parallel region.

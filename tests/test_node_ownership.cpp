@@ -1,18 +1,20 @@
 // Which thread works on which grid nodes (kernels/node_ownership.hpp): the
 // split follows the particles' tiles (balanced inside the band the threads
-// share), and the node loops that use it give the same results whatever
-// the split and the thread count.
+// share), and the node loops that use it (with the supports they apply)
+// give the same results whatever the split and the thread count.
 #include <gtest/gtest.h>
 #include <omp.h>
 
 #include <algorithm>
 #include <cstring>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "kernels/binning.hpp"
 #include "kernels/grid_update.hpp"
 #include "kernels/node_ownership.hpp"
+#include "kernels/supports.hpp"
 
 namespace {
 
@@ -138,6 +140,18 @@ struct UpdateGrid {
   }
 };
 
+// p, vel and dvel of both grids bit for bit.
+void expect_same_momenta_and_velocities(const UpdateGrid& ref, const UpdateGrid& g,
+                                        const std::string& where) {
+  for (auto [a, b] : {std::pair{&ref.p0, &g.p0},
+                      {&ref.p1, &g.p1},
+                      {&ref.v0, &g.v0},
+                      {&ref.v1, &g.v1},
+                      {&ref.dv0, &g.dv0},
+                      {&ref.dv1, &g.dv1}})
+    EXPECT_EQ(std::memcmp(a->data(), b->data(), a->size() * sizeof(double)), 0) << where;
+}
+
 TEST(NodeOwnership, GridUpdateAndVelocitiesBitwiseWhateverTheSplit) {
   // 300 x 170 nodes (13 reduction chunks per field), damping on so the
   // loss is a real sum; 1 thread vs 2 threads with several cuts.
@@ -166,14 +180,9 @@ TEST(NodeOwnership, GridUpdateAndVelocitiesBitwiseWhateverTheSplit) {
            {}, {0, 1, n}, {0, 4096 * 5 + 17, n}, {0, n, n}, {0, 0, n}}) {
     UpdateGrid g(dims);
     const double loss = run(2, split, g);
-    EXPECT_EQ(loss, loss_ref) << "split at " << (split.empty() ? 0 : split[1]);
-    for (auto [a, b] : {std::pair{&ref.p0, &g.p0},
-                        {&ref.p1, &g.p1},
-                        {&ref.v0, &g.v0},
-                        {&ref.v1, &g.v1},
-                        {&ref.dv0, &g.dv0},
-                        {&ref.dv1, &g.dv1}})
-      EXPECT_EQ(std::memcmp(a->data(), b->data(), a->size() * sizeof(double)), 0);
+    const std::string where = "split at " + std::to_string(split.empty() ? 0 : split[1]);
+    EXPECT_EQ(loss, loss_ref) << where;
+    expect_same_momenta_and_velocities(ref, g, where);
   }
 }
 
@@ -199,6 +208,127 @@ TEST(NodeOwnership, MomentumVelocitiesBitwiseWhateverTheSplit) {
     for (auto [a, b] : {std::pair{&ref.v0, &g.v0}, {&ref.v1, &g.v1}})
       EXPECT_EQ(std::memcmp(a->data(), b->data(), a->size() * sizeof(double)), 0)
           << "split at " << (split.empty() ? 0 : split[1]);
+  }
+}
+
+// The supports as the Stepper applied them before they moved into the node
+// passes: one serial loop after the pass, the reaction summed as it went.
+std::array<double, 3> serial_supports(UpdateGrid& g, const mmpm::SupportView<double>& bc,
+                                      const unsigned char* rigid, double thr, double dt,
+                                      bool with_dvel) {
+  std::array<double, 3> reaction{0, 0, 0};
+  for (int f = 0; f < g.G.fields; ++f) {
+    if (rigid[f]) continue;
+    for (std::size_t k = 0; k < bc.count; ++k) {
+      const std::size_t i = std::size_t(f) * g.nodes + bc.nodes[k];
+      const double m = g.G.m[i];
+      if (!(m > thr)) {
+        if (with_dvel)
+          for (int d = 0; d < 2; ++d)
+            if (bc.fix[d]) g.V.dvel[d][i] = 0;
+        continue;
+      }
+      for (int d = 0; d < 2; ++d) {
+        if (!bc.fix[d]) continue;
+        const double change = bc.velocity[d] - g.V.vel[d][i];
+        reaction[std::size_t(d)] += m * change / dt;
+        g.V.vel[d][i] = bc.velocity[d];
+        if (with_dvel) g.V.dvel[d][i] += change;
+        g.G.p[d][i] = m * bc.velocity[d];
+      }
+    }
+  }
+  return reaction;
+}
+
+TEST(NodeOwnership, SupportsAppliedByTheOwnersMatchTheSerialLoopBitwise) {
+  // Two supports sharing a corner node on 300 x 170 nodes (slivers and
+  // empty nodes among them): the left column fixed in x and y, the bottom
+  // row in y, moving. Field 1 rigid in the second round (supports skip it).
+  // Each node pass with the supports as its hook, on 2 threads with
+  // several cuts, against the pass on 1 thread followed by the serial loop.
+  const std::array<int, 3> dims{300, 170, 1};
+  std::vector<std::uint32_t> left, bottom;
+  for (std::uint32_t j = 0; j < 170; ++j) left.push_back(j * 300);
+  for (std::uint32_t i = 0; i < 300; ++i) bottom.push_back(i);
+  const double thr = 1e-12, dt = 1e-3;
+  mmpm::GridUpdateParams q;
+  q.dt = dt;
+  q.mass_threshold = thr;
+  q.body_accel[1] = -9.81;
+  q.velocities = true;
+  for (const unsigned char rigid1 : {0, 1}) {
+    const unsigned char rigid[2] = {0, rigid1};
+    std::vector<double> terms_left(2 * left.size() * 2, -1.0), terms_bottom(2 * bottom.size() * 2);
+    std::array<mmpm::SupportView<double>, 2> views{};
+    views[0].nodes = left.data(), views[0].count = left.size();
+    views[0].fix[0] = views[0].fix[1] = true;
+    views[0].velocity[0] = 0.25, views[0].velocity[1] = -0.5;
+    views[0].reaction_terms = terms_left.data();
+    views[1].nodes = bottom.data(), views[1].count = bottom.size();
+    views[1].fix[1] = true;
+    views[1].velocity[1] = 0.125;
+    views[1].reaction_terms = terms_bottom.data();
+    // The three passes that apply supports: the update with velocities
+    // (with dvel), grid_velocities (with dvel), grid_momentum_velocities.
+    for (int pass = 0; pass < 3; ++pass) {
+      const bool with_dvel = pass < 2;
+      UpdateGrid ref(dims);
+      if (pass == 0) {
+        mmpm::grid_update(ref.G, ref.V, q, {});
+      } else if (pass == 1) {
+        mmpm::GridUpdateParams q2 = q;
+        q2.velocities = false;
+        mmpm::grid_update(ref.G, ref.V, q2, {});
+        mmpm::grid_velocities(ref.G, ref.V, thr, {});
+      } else {
+        mmpm::grid_momentum_velocities(ref.G, ref.V, thr, {});
+      }
+      std::array<std::array<double, 3>, 2> want{};
+      for (int s = 0; s < 2; ++s)
+        want[s] = serial_supports(ref, views[s], rigid, thr, dt, with_dvel);
+      const std::size_t n = ref.nodes;
+      for (const auto& split : std::vector<std::vector<std::size_t>>{
+               {}, {0, 1, n}, {0, 4096 * 5 + 17, n}, {0, 150 * 300 + 1, n}, {0, n, n}}) {
+        UpdateGrid g(dims);
+        const int saved = omp_get_max_threads();
+        omp_set_num_threads(2);
+        NodeOwnership own;
+        own.split = split;
+        mmpm::Supports<double> S;
+        S.list = views.data(), S.count = 2, S.rigid = rigid;
+        S.mass_threshold = thr, S.dt = dt, S.with_dvel = with_dvel;
+        auto hook = [&](int f, std::size_t b, std::size_t e) {
+          mmpm::apply_supports(g.G, g.V, S, f, b, e);
+        };
+        if (pass == 0) {
+          mmpm::grid_update(g.G, g.V, q, own, hook);
+        } else if (pass == 1) {
+          mmpm::GridUpdateParams q2 = q;
+          q2.velocities = false;
+          mmpm::grid_update(g.G, g.V, q2, own);
+          mmpm::grid_velocities(g.G, g.V, thr, own, hook);
+        } else {
+          mmpm::grid_momentum_velocities(g.G, g.V, thr, own, hook);
+        }
+        omp_set_num_threads(saved);
+        const std::string where = "pass " + std::to_string(pass) + ", rigid field 1 " +
+                                  std::to_string(int(rigid1)) + ", split at " +
+                                  std::to_string(split.empty() ? 0 : split[1]);
+        expect_same_momenta_and_velocities(ref, g, where);
+        if (!with_dvel) continue;
+        for (int s = 0; s < 2; ++s) {
+          const auto got = mmpm::sum_support_reaction<2>(views[s], 2, rigid);
+          for (int d = 0; d < 3; ++d)
+            EXPECT_EQ(got[std::size_t(d)], want[s][std::size_t(d)]) << where << ", support " << s;
+        }
+        // The supports did act: the fixed velocities are the support's.
+        EXPECT_EQ(g.v0[left[5]], g.m[left[5]] > thr ? 0.25 : 0.0) << where;
+      }
+      if (with_dvel) {
+        EXPECT_NE(want[0][0], 0.0);
+      }
+    }
   }
 }
 

@@ -21,6 +21,7 @@
 #include "kernels/p2g_multimaterial.hpp"
 #include "kernels/reduce.hpp"
 #include "kernels/shape.hpp"
+#include "kernels/supports.hpp"
 #include "model/bodies.hpp"
 #include "model/material.hpp"
 #include "scene/error.hpp"
@@ -115,7 +116,8 @@ class Stepper final : public Simulation {
   void grid_update_stage();
   void update_node_ownership(bool rebuilt);
   void finish_velocities(bool with_dvel);
-  void apply_boundaries(bool with_dvel);
+  Supports<Real> supports(bool with_dvel);
+  void collect_support_reactions();
   void update_tractions();
   [[noreturn]] void fail_particle(const char* stage, std::size_t p, const std::string& why) const;
   void tic() { t0_ = Clock::now(); }
@@ -170,6 +172,8 @@ class Stepper final : public Simulation {
   MultimaterialStage<D, Real> mm_;
   std::vector<double> rigid_velocity_now_;  // per field x 3 at t + dt
   std::vector<Vec3> boundary_reaction_;
+  std::vector<SupportView<Real>> support_views_;    // per boundary, over boundaries_' lists
+  std::vector<std::vector<double>> support_terms_;  // per boundary: reaction terms
 
   double external_work_ = 0, damping_loss_ = 0;
   std::array<double, kStageCount> stage_s_{};

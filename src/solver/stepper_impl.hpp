@@ -25,6 +25,10 @@ Stepper<D, Shape, Real>::Stepper(const Scene& scene) : scene_(scene), plan_(plan
   setup_grid();
   setup_particles(make_particles(scene));
   mm_.setup(scene, plan_, G_, mass_threshold_, dt_);
+  support_views_.resize(boundaries_.size());
+  support_terms_.resize(boundaries_.size());
+  for (std::size_t b = 0; b < boundaries_.size(); ++b)
+    support_terms_[b].assign(std::size_t(plan_.fields) * boundaries_[b].nodes.size() * D, 0.0);
   rigid_velocity_now_.assign(std::size_t(plan_.fields) * 3, 0.0);
 }
 
@@ -464,60 +468,68 @@ void Stepper<D, Shape, Real>::grid_update_stage() {
   q.rigid = plan_.rigid.data();
   q.rigid_velocity = reinterpret_cast<const double(*)[3]>(rigid_velocity_now_.data());
   q.has_interface_force = mm_.has_interface_forces();
-  // Without pass B nothing changes p before the velocities: one pass.
+  // Without pass B nothing changes p before the velocities: one pass, which
+  // also applies the supports.
   q.velocities = !plan_.multimaterial;
-  damping_loss_ += grid_update(G_, GV_, q, own_);
+  if (q.velocities) {
+    const Supports<Real> s = supports(true);
+    damping_loss_ += grid_update(G_, GV_, q, own_, [&](int f, std::size_t b, std::size_t e) {
+      apply_supports(G_, GV_, s, f, b, e);
+    });
+    collect_support_reactions();
+  } else {
+    damping_loss_ += grid_update(G_, GV_, q, own_);
+  }
 }
 
-// Supports: the fixed components get the support's velocity; the momentum
-// this takes is the reaction force (what a load cell would read).
+// The supports for this step (kernels/supports.hpp), applied by the node
+// passes on the nodes each thread owns; with_dvel: the application after
+// the momentum update, which records the reaction terms.
 template <int D, class Shape, class Real>
-void Stepper<D, Shape, Real>::apply_boundaries(bool with_dvel) {
+Supports<Real> Stepper<D, Shape, Real>::supports(bool with_dvel) {
   for (std::size_t b = 0; b < boundaries_.size(); ++b) {
+    // The pointers are set here, not once, so they follow the Stepper's
+    // own vectors whatever happened to it since.
     const BoundaryNodes& bc = boundaries_[b];
+    SupportView<Real>& v = support_views_[b];
+    v.nodes = bc.nodes.data();
+    v.count = bc.nodes.size();
+    v.reaction_terms = support_terms_[b].data();
     const Vec3 vb = boundary_velocity(bc, time_, dt_);
-    Vec3 reaction{0, 0, 0};
-    for (int f = 0; f < G_.fields; ++f) {
-      if (plan_.rigid[std::size_t(f)]) continue;
-      const std::size_t o = std::size_t(f) * G_.nodes;
-      for (std::uint32_t node : bc.nodes) {
-        const std::size_t i = o + node;
-        const Real m = G_.m[i];
-        if (!(m > mass_threshold_)) {
-          // A sliver node on a support: the support absorbs its increment.
-          if (with_dvel)
-            for (int d = 0; d < D; ++d)
-              if (bc.fix[d]) GV_.dvel[d][i] = Real(0);
-          continue;
-        }
-        for (int d = 0; d < D; ++d) {
-          if (!bc.fix[d]) continue;
-          const Real v_target = Real(vb[d]);
-          const Real change = v_target - GV_.vel[d][i];
-          reaction[d] += double(m) * double(change) / dt_;
-          GV_.vel[d][i] = v_target;
-          if (with_dvel) GV_.dvel[d][i] += change;
-          G_.p[d][i] = m * v_target;
-        }
-      }
-    }
-    // Only the application after the momentum update is the support's
-    // impulse for the step (USF and MUSL also enforce it on other transfers).
-    if (with_dvel) {
-      boundary_reaction_[b] = reaction;
-      for (int d = 0; d < D; ++d) external_work_ += reaction[d] * vb[d] * dt_;
-    }
+    for (int d = 0; d < 3; ++d) v.fix[d] = bc.fix[d], v.velocity[d] = Real(vb[d]);
+  }
+  Supports<Real> s;
+  s.list = support_views_.data();
+  s.count = support_views_.size();
+  s.rigid = plan_.rigid.data();
+  s.mass_threshold = mass_threshold_;
+  s.dt = dt_;
+  s.with_dvel = with_dvel;
+  return s;
+}
+
+// The reactions (what a load cell would read) and the supports' work, from
+// the terms the application after the momentum update wrote.
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::collect_support_reactions() {
+  for (std::size_t b = 0; b < boundaries_.size(); ++b) {
+    const Vec3 vb = boundary_velocity(boundaries_[b], time_, dt_);
+    const Vec3 r = sum_support_reaction<D>(support_views_[b], G_.fields, plan_.rigid.data());
+    boundary_reaction_[b] = r;
+    for (int d = 0; d < D; ++d) external_work_ += r[d] * vb[d] * dt_;
   }
 }
 
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::finish_velocities(bool with_dvel) {
+  const Supports<Real> s = supports(with_dvel);
+  auto hook = [&](int f, std::size_t b, std::size_t e) { apply_supports(G_, GV_, s, f, b, e); };
   if (with_dvel) {
-    grid_velocities(G_, GV_, mass_threshold_, own_);
+    grid_velocities(G_, GV_, mass_threshold_, own_, hook);
+    collect_support_reactions();
   } else {
-    grid_momentum_velocities(G_, GV_, mass_threshold_, own_);
+    grid_momentum_velocities(G_, GV_, mass_threshold_, own_, hook);
   }
-  apply_boundaries(with_dvel);
 }
 
 template <int D, class Shape, class Real>
@@ -617,12 +629,11 @@ void Stepper<D, Shape, Real>::step() {
     mm_.pass_b(G_, own_);
     toc(kStageMultimaterial);
   }
-  tic();
-  if (mm)
+  if (mm) {  // else grid_update_stage set the velocities
+    tic();
     finish_velocities(true);
-  else
-    apply_boundaries(true);  // grid_update_stage set the velocities
-  toc(kStageGrid);
+    toc(kStageGrid);
+  }
 
   if (scheme == Scheme::USL) {
     gradient_and_stress<kUpdateMotion>();
