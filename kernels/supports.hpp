@@ -66,10 +66,12 @@ void apply_supports(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
       const Real m = G.m[i];
       if (!(m > S.mass_threshold)) {
         // A sliver node on a support: the support absorbs its increment.
-        for (int d = 0; d < D; ++d) {
-          if (!bc.fix[d]) continue;
-          if (S.with_dvel) V.dvel[d][i] = Real(0), terms[k * D + d] = 0.0;
-        }
+        if (S.with_dvel)
+          for (int d = 0; d < D; ++d) {
+            if (!bc.fix[d]) continue;
+            V.dvel[d][i] = Real(0);
+            terms[k * D + d] = 0.0;
+          }
         continue;
       }
       for (int d = 0; d < D; ++d) {
