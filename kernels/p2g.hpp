@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "kernels/p2g_packed.hpp"
 #include "kernels/weight_batch.hpp"
 #include "kernels/weights.hpp"
 #include "kernels/window_block.hpp"
@@ -159,7 +160,9 @@ std::size_t p2g_range(const ParticleView<D, Real>& P, const GridView<D, Real>& G
   if (!Win::fits(G))
     return p2g_range_pointwise<D, Shape, Real, What, MultiField, Traction>(P, G, opt, begin, end);
   constexpr int UG = block_group_units<D, Shape, Real, What, Traction>();
-  if constexpr (UG < Win::units)
+  if constexpr (packed_particles<D, Shape, Real>() > 1)
+    return p2g_range_packed<Real, What, MultiField, Traction>(P, G, opt, begin, end);
+  else if constexpr (UG < Win::units)
     return p2g_range_grouped<D, Shape, Real, What, MultiField, Traction, UG>(P, G, opt, begin, end);
   else
     return p2g_range_one_block<D, Shape, Real, What, MultiField, Traction>(P, G, opt, begin, end);

@@ -231,6 +231,34 @@ class WindowBuilder {
     Real r[D][kWeightBatch];
     std::uint64_t window_base[kWeightBatch];
     int inside[kWeightBatch];
+    locate_batch(P, first, count, r, window_base, inside);
+    const Real* lp[D];
+    for (int d = 0; d < D; ++d) lp[d] = Shape::S == 3 && P.lp[d] ? P.lp[d] + first : nullptr;
+    for (std::size_t i = 0; i < count; ++i) {
+      ok[i] = inside[i] != 0;
+      if (!ok[i]) continue;
+      Real ri[DP], li[DP];
+      for (int d = 0; d < D; ++d) {
+        ri[d] = r[d][i];
+        li[d] = lp[d] ? lp[d][i] : Real(0.25);
+      }
+      shape(ri, li, w[i]);
+      w[i].base = window_base[i];
+    }
+  }
+
+  // The scalar part of build() for particles first .. first + count - 1
+  // (count <= kWeightBatch), in one loop the compiler vectorises across
+  // particles: distances r[d][i] from the window base (cell units; a finite
+  // 0 - base off the grid), the base's node index and inside[i] (1 when the
+  // stencil stays on the grid).
+  // Arrays longer than the batch (N) leave their tail as it was.
+  template <std::size_t N>
+  [[gnu::always_inline]] void locate_batch(const ParticleView<D, Real>& P, std::size_t first,
+                                           std::size_t count, Real (&r)[D][N],
+                                           std::uint64_t (&window_base)[N],
+                                           int (&inside)[N]) const {
+    static_assert(N >= kWeightBatch);
     const Real* __restrict x[D];
     for (int d = 0; d < D; ++d) x[d] = P.x[d] + first;
 #pragma GCC ivdep
@@ -253,19 +281,11 @@ class WindowBuilder {
       window_base[i] = b;
       inside[i] = in_all;
     }
-    const Real* lp[D];
-    for (int d = 0; d < D; ++d) lp[d] = Shape::S == 3 && P.lp[d] ? P.lp[d] + first : nullptr;
-    for (std::size_t i = 0; i < count; ++i) {
-      ok[i] = inside[i] != 0;
-      if (!ok[i]) continue;
-      Real ri[DP], li[DP];
-      for (int d = 0; d < D; ++d) {
-        ri[d] = r[d][i];
-        li[d] = lp[d] ? lp[d][i] : Real(0.25);
-      }
-      shape(ri, li, w[i]);
-      w[i].base = window_base[i];
-    }
+  }
+
+  // 1 / h per direction (the derivatives' factor).
+  Real inverse_spacing(int d) const {
+    return inv_h[d];
   }
 
   // x when keep is 1, +0 when it is 0, by a bit mask. A select on a float
