@@ -109,7 +109,7 @@ struct PackedLinearBlock {
                         kGrad = Base::kGrad;
 
   VW am, ap[2], af[2], avol, amx[2], ag[2];
-  std::size_t current = SIZE_MAX;
+  std::size_t current = SIZE_MAX;  // window base (with field offset); SIZE_MAX: none
 
   PackedLinearBlock() { clear(); }
 
@@ -141,16 +141,6 @@ struct PackedLinearBlock {
       if constexpr (kGrad) add(G.g[d], ag[d]);
     }
     if constexpr (kMM) add(G.vol, avol);
-  }
-
-  [[gnu::always_inline]] void at(std::size_t b, const GridView<2, Real>& G,
-                                 const typename Win::Offsets& off) {
-    if (b == current) return;
-    if (current != SIZE_MAX) {
-      flush(G, off);
-      clear();
-    }
-    current = b;
   }
 
   // Adds K particles with distances rx, ry from the window base (cell
