@@ -7,6 +7,7 @@
 // node, so they are unaligned.
 #pragma once
 
+#include <cstddef>
 #include <cstring>
 #include <type_traits>
 #include <utility>
@@ -66,6 +67,18 @@ inline Real lanes_sum(const V& a) {
   Real s = 0;
   for (int k = 0; k < W; ++k) s += a[k];
   return s;
+}
+
+// N lanes picked from a: lane k of the result is a[pick(k)], pick a
+// captureless index function (the window kernels' lane layouts).
+template <class V, class F, std::size_t... I>
+[[gnu::always_inline]] inline Lanes<LaneReal<V>, int(sizeof...(I))> lanes_pick_of(
+    const V& a, F, std::index_sequence<I...>) {
+  return __builtin_shufflevector(a, a, F{}(int(I))...);
+}
+template <int N, class V, class F>
+[[gnu::always_inline]] inline Lanes<LaneReal<V>, N> lanes_pick(const V& a, F pick) {
+  return lanes_pick_of(a, pick, std::make_index_sequence<std::size_t(N)>{});
 }
 
 // Halves added until 4 lanes remain (a vector of 4, 8 or 16 lanes).

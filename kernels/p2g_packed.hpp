@@ -108,21 +108,14 @@ struct PackedLinearBlock {
   static constexpr bool kMass = Base::kMass, kMom = Base::kMom, kFrc = Base::kFrc, kMM = Base::kMM,
                         kGrad = Base::kGrad;
 
-  VW am, ap[2], af[2], avol, amx[2], ag[2];
+  VW am{}, ap[2]{}, af[2]{}, avol{}, amx[2]{}, ag[2]{};
   std::size_t current = SIZE_MAX;  // window base (with field offset); SIZE_MAX: none
-
-  PackedLinearBlock() { clear(); }
-
-  [[gnu::always_inline]] void clear() {
-    am = avol = VW{};
-    for (int d = 0; d < 2; ++d) ap[d] = af[d] = amx[d] = ag[d] = VW{};
-  }
 
   // Slots k0 .. k0 + count - 1 added pairwise (lane l: window lane l).
   template <int k0, int count>
   [[gnu::always_inline]] static V slot_sum(const VW& a) {
     if constexpr (count == 1)
-      return pick(a, [](int l) { return k0 * L + l; });
+      return lanes_pick<L>(a, [](int l) { return k0 * L + l; });
     else
       return slot_sum<k0, count / 2>(a) + slot_sum<k0 + count / 2, count / 2>(a);
   }
@@ -177,14 +170,6 @@ struct PackedLinearBlock {
   }
 
  private:
-  template <class F, std::size_t... I>
-  static V pick_of(const VW& a, F, std::index_sequence<I...>) {
-    return __builtin_shufflevector(a, a, F{}(int(I))...);
-  }
-  template <class F>
-  static V pick(const VW& a, F f) {
-    return pick_of(a, f, std::make_index_sequence<L>{});
-  }
   // Lane k * L + l = lane k of s: s widened in its register, then one
   // permute. (GCC 12 widens a 16-byte vector extension to 64 bytes through
   // the stack, a store and a wider load that cannot be forwarded: 30

@@ -139,13 +139,9 @@ struct Window {
 
  private:
   // Lanes of a picked by a constexpr index function of the unit lane.
-  template <class F, std::size_t... I>
-  static V pick_of(const VA& a, F, std::index_sequence<I...>) {
-    return __builtin_shufflevector(a, a, F{}(int(I))...);
-  }
   template <class F>
   static V pick(const VA& a, F f) {
-    return pick_of(a, f, std::make_index_sequence<L>{});
+    return lanes_pick<L>(a, f);
   }
   // Product of the y factor (from ya) and the z factor (from za) of unit u.
   template <int u>
