@@ -9,43 +9,14 @@
 #include <type_traits>
 
 #include "kernels/constitutive.hpp"
+#include "kernels/g2p_packed.hpp"
+#include "kernels/g2p_particle.hpp"
 #include "kernels/grid_update.hpp"
 #include "kernels/weight_batch.hpp"
 #include "kernels/weights.hpp"
 #include "kernels/window_block.hpp"
 
 namespace mmpm {
-
-enum G2PWhat : unsigned {
-  kUpdateMotion = 1u,      // v and x (x_next under MUSL)
-  kVelocityGradient = 2u,  // L = sum v_i (x) G_ip
-  // MUSL's fused passes (Stepper::step): the new particle momentum m v goes
-  // straight back to the grid momentum with the same weights (the second
-  // transfer), so the caller must run tiles color by color like P2G; and
-  // the velocity-gradient pass moves x to x_next when it is done with x.
-  kScatterMomentum = 4u,
-  kCommitPosition = 8u,
-  // With kVelocityGradient: the constitutive update of each particle right
-  // after its L (the StressFn argument), instead of a pass of its own.
-  kStressUpdate = 16u,
-};
-
-struct G2PParams {
-  double dt = 0;
-  double flip = 1;
-  const unsigned char* rigid = nullptr;         // per field
-  const double (*rigid_velocity)[3] = nullptr;  // per field, at t + dt
-  double body_accel[3] = {0, 0, 0};             // for the external work of gravity
-};
-
-// Outcome of a G2P range: first bad particle (stencil off the grid or
-// non-finite velocity), work of external forces, particles that changed tile.
-struct G2PRangeResult {
-  std::size_t bad = SIZE_MAX;
-  std::size_t unsound = SIZE_MAX;  // kStressUpdate: first particle with J <= 0 or non-finite stress
-  double external_work = 0;
-  bool moved_tile = false;
-};
 
 // Gathers the grid velocity, velocity change and velocity gradient of one
 // particle. Windowed: rows of W nodes along x, with the separable sums
@@ -245,51 +216,17 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
       return true;
     }
     const Weights& w = *weights;
-    const int field = MultiField ? int(P.field[p]) : 0;
     const std::size_t fo = field_offset<MultiField>(P, G, p);
-    if constexpr ((What & kUpdateMotion) != 0) {
-      if (MultiField && q.rigid && q.rigid[field]) {  // prescribed motion (§7)
-        for (int d = 0; d < D; ++d) {
-          P.v[d][p] = Real(q.rigid_velocity[field][d]);
-          if (P.x_next[0])
-            P.x_next[d][p] = P.x[d][p] + dt * P.v[d][p];
-          else
-            P.x[d][p] += dt * P.v[d][p];
-        }
-        if constexpr (kScatter) scatter_momentum(w, p, fo);
-        return true;
-      }
+    if (detail::rigid_motion<D, Real, What, MultiField>(P, q, dt, p)) {
+      if constexpr (kScatter) scatter_momentum(w, p, fo);
+      return true;
     }
     Real vn[D] = {}, dv[D] = {}, L[D * D] = {};
     st.template gather<(What & kUpdateMotion) != 0, (What & kVelocityGradient) != 0>(w, V, fo, held,
                                                                                      vn, dv, L);
-    if constexpr ((What & kUpdateMotion) != 0) {
-      bool finite = true;
-      double work = 0;
-      for (int d = 0; d < D; ++d) {
-        const Real vnew = flip * (P.v[d][p] + dv[d]) + pic * vn[d];
-        P.v[d][p] = vnew;
-        if (P.x_next[0])
-          P.x_next[d][p] = P.x[d][p] + dt * vn[d];
-        else
-          P.x[d][p] += dt * vn[d];
-        finite = finite && std::isfinite(vnew);
-        // Work = force times the displacement of the material point, which
-        // moves with the grid velocity (not with its FLIP velocity).
-        const double vmove = double(vn[d]);
-        if constexpr (Traction) work += double(P.fext[d][p]) * vmove;
-        if constexpr (Gravity) work += double(P.m[p]) * q.body_accel[d] * vmove;
-      }
-      if constexpr (Traction || Gravity) r.external_work += work * q.dt;
-      if (!finite && r.bad == SIZE_MAX) r.bad = p;
-      if constexpr (kScatter) scatter_momentum(w, p, fo);
-    }
-    if constexpr ((What & kVelocityGradient) != 0)
-      for (int c = 0; c < D * D; ++c) P.L[c][p] = L[c];
-    if constexpr ((What & kStressUpdate) != 0)
-      if (!stress(P, p) && r.unsound == SIZE_MAX) r.unsound = p;
-    if constexpr ((What & kCommitPosition) != 0)
-      for (int d = 0; d < D; ++d) P.x[d][p] = P.x_next[d][p];
+    detail::update_particle<D, Real, What, Traction, Gravity>(P, q, dt, flip, pic, p, vn, dv, L, r,
+                                                              stress);
+    if constexpr (kScatter) scatter_momentum(w, p, fo);
     return true;
   };
   auto after_batch = [&](std::size_t first, std::size_t n, const Weights* w, const bool* ok) {
@@ -318,17 +255,21 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
   return r;
 }
 
-// The solver's G2P: windowed, and pointwise (node by node) only for grids
-// too small for a window. 2D linear was pointwise while its windows were
-// built particle by particle (12.7 vs 13.6 ns/particle); with the windows
-// built a batch at a time (WindowBuilder::build_batch) the window wins
-// there too (docs/performance.md "Windows a batch at a time, across
-// particles").
+// The solver's G2P: packed for 2D linear float without the momentum
+// scatter (kernels/g2p_packed.hpp, the same sums), else windowed, and
+// pointwise (node by node) only for grids too small for a window. 2D linear was pointwise while its
+// windows were built particle by particle (12.7 vs 13.6 ns/particle); with the windows built a
+// batch at a time (WindowBuilder::build_batch) the window wins there too (docs/performance.md
+// "Windows a batch at a time, across particles").
 template <int D, class Shape, class Real, unsigned What, bool MultiField, bool Traction,
           bool Gravity, class KeyFn, class StressFn = NoStressUpdate>
 G2PRangeResult g2p_range(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
                          const GridVelocity<D, Real>& V, const G2PParams& q, const KeyFn& key_of,
                          std::size_t begin, std::size_t end, const StressFn& stress = {}) {
+  if constexpr (packed_gather_pays<D, Shape, Real>() && (What & kScatterMomentum) == 0)
+    if (Window<D, Shape, Real>::fits(G))
+      return g2p_range_packed<Real, What, MultiField, Traction, Gravity>(P, G, V, q, key_of, begin,
+                                                                         end, stress);
   if (Window<D, Shape, Real>::fits(G))
     return g2p_range_impl<D, Shape, Real, What, MultiField, Traction, Gravity, true>(
         P, G, V, q, key_of, begin, end, stress);

@@ -6,7 +6,8 @@
 // scattered grid loads; in lanes across nodes the work of different nodes
 // overlaps (independent chains, array-by-array gathers), and the lane loops
 // run in SIMD registers: GCC vectorises both passes for every law (but
-// Coulomb friction in 3D pass A). Pass A's loop is written for
+// Coulomb friction in 3D pass A), checked in the solver binary by
+// tools/check_vectorised.py. Pass A's loop is written for
 // that: selects between Reals only, no run-time flag inside
 // (docs/multimaterial.md "Pass A in SIMD lanes").
 //
@@ -173,9 +174,16 @@ inline VecD<D, Real> lane(const Real* v, int i) {
 // (Law::interface: the imperfect interface with explicit integration),
 // with Δf in the force limit when UseDf (a template parameter: a select on
 // a run-time flag kept GCC from vectorising the loop).
+//
+// flatten: every helper called in the lane loop is inlined. A single call
+// left out of line keeps the whole loop scalar, and GCC 12 left different
+// ones out in different translation units of the solver (h_perp in 3D
+// double, momentum_change_to_center_of_mass in 3D float), which the
+// vectorised_loops test found in build/mmpm (docs/multimaterial.md "Pass A
+// in SIMD lanes").
 template <NormalMethod M, Law L, bool UseDf, int D, class Real>
-void pass_a_lanes(PairBatch<D, Real>& B, Real sign, const std::array<Real, 3>& h, Real dt,
-                  Real thickness) {
+[[gnu::flatten]] void pass_a_lanes(PairBatch<D, Real>& B, Real sign, const std::array<Real, 3>& h,
+                                   Real dt, Real thickness) {
   const PairParams<Real>& pp = *B.params;
   const Real omega_min = pp.omega_min, friction = pp.friction;
   const bool position_method = pp.separation == Separation::position;
@@ -313,8 +321,9 @@ void pass_a_lanes(PairBatch<D, Real>& B, Real sign, const std::array<Real, 3>& h
 
 // Pass B on the lanes of B from pass A's saved normal and separation (B.n,
 // B.dn) and stick flags (B.stick): interact_pass_b_saved lane by lane.
+// flatten: as pass_a_lanes.
 template <Law L, int D, class Real>
-void pass_b_lanes(PairBatch<D, Real>& B) {
+[[gnu::flatten]] void pass_b_lanes(PairBatch<D, Real>& B) {
   const Real friction = B.params->friction;
   const int count = B.count;
 #pragma GCC ivdep

@@ -24,31 +24,14 @@
 // on the particle order within a tile (tests/test_p2g.cpp).
 #pragma once
 
-#include <immintrin.h>
-
 #include <cstddef>
 #include <cstdint>
 #include <type_traits>
 
-#include "kernels/shape.hpp"
+#include "kernels/packed_linear.hpp"
 #include "kernels/window_block.hpp"
 
 namespace mmpm {
-
-// Particles per vector of the packed scatter (1: the kernel does not apply).
-// Needs AVX-512 (PackedLinearBlock::spread); elsewhere the one-particle
-// block runs.
-template <int D, class Shape, class Real>
-constexpr int packed_particles() {
-#ifdef __AVX512F__
-  if constexpr (D != 2 || !std::is_same_v<Shape, LinearShape>)
-    return 1;
-  else
-    return 64 / int(sizeof(typename Window<D, Shape, Real>::V));
-#else
-  return 1;
-#endif
-}
 
 // The factors (ScatterSource) of K consecutive particles, one lane each;
 // lanes at and past `count` are 0, so they add nothing.
@@ -141,60 +124,29 @@ struct PackedLinearBlock {
   // (weight 1 - |d|, derivative sign(-d) / h), as WindowBuilder::shape.
   [[gnu::always_inline]] void accumulate(const S& rx, const S& ry, Real inv_hx, Real inv_hy,
                                          const Source& q) {
-    const VW dx = spread(rx) + node_offsets([](int l) { return l % 2; });
-    const VW dy = spread(ry) + node_offsets([](int l) { return l / 2; });
-    const VW X = Real(1) - lanes_abs(dx), Y = Real(1) - lanes_abs(dy);
-    const VW GX = dx < Real(0) ? inv_hx + VW{} : -inv_hx + VW{};
-    const VW GY = dy < Real(0) ? inv_hy + VW{} : -inv_hy + VW{};
-    const VW s = X * Y, Gx = GX * Y, Gy = X * GY;
-    if constexpr (kMass) am += s * spread(q.m);
+    using PL = PackedLinearLanes<Real, K>;
+    const PL w = PL::of(rx, ry, inv_hx, inv_hy);
+    const VW s = w.X * w.Y, Gx = w.GX * w.Y, Gy = w.X * w.GY;
+    if constexpr (kMass) am += s * PL::spread(q.m);
     if constexpr (kMom)
-      for (int d = 0; d < 2; ++d) ap[d] += s * spread(q.mv[d]);
+      for (int d = 0; d < 2; ++d) ap[d] += s * PL::spread(q.mv[d]);
     if constexpr (kFrc) {
       // f = -V sigma . G (+ S fext); sigma: xx, yy, xy (window_block.hpp)
-      const VW v0 = spread(q.vs[0]), v1 = spread(q.vs[1]), v2 = spread(q.vs[2]);
+      const VW v0 = PL::spread(q.vs[0]), v1 = PL::spread(q.vs[1]), v2 = PL::spread(q.vs[2]);
       af[0] -= v0 * Gx + v2 * Gy;
       af[1] -= v2 * Gx + v1 * Gy;
       if constexpr (Traction)
-        for (int d = 0; d < 2; ++d) af[d] += s * spread(q.fe[d]);
+        for (int d = 0; d < 2; ++d) af[d] += s * PL::spread(q.fe[d]);
     }
     if constexpr (kMM) {
-      const VW area = spread(q.area);
+      const VW area = PL::spread(q.area);
       avol += s * area;
-      for (int d = 0; d < 2; ++d) amx[d] += s * spread(q.mw[d]);
+      for (int d = 0; d < 2; ++d) amx[d] += s * PL::spread(q.mw[d]);
       if constexpr (kGrad) {
         ag[0] += Gx * area;
         ag[1] += Gy * area;
       }
     }
-  }
-
- private:
-  // Lane k * L + l = lane k of s: s widened in its register, then one
-  // permute. (GCC 12 widens a 16-byte vector extension to 64 bytes through
-  // the stack, a store and a wider load that cannot be forwarded: 30
-  // instead of 5.5 ns/particle. Hence the zero-extending intrinsic; the
-  // casting one and _mm512_permutexvar read an "undefined" vector that
-  // GCC 12 reports as uninitialised.)
-  template <std::size_t... I>
-  [[gnu::always_inline]] static VW spread_of(const VW& w, std::index_sequence<I...>) {
-    return __builtin_shufflevector(w, w, int(I / L)...);
-  }
-  [[gnu::always_inline]] static VW spread(const S& s) {
-    static_assert(sizeof(S) == 16 && sizeof(VW) == 64);
-    VW w;
-    if constexpr (std::is_same_v<Real, double>)
-      w = VW(_mm512_zextpd128_pd512(__m128d(s)));
-    else
-      w = VW(_mm512_zextps128_ps512(__m128(s)));
-    return spread_of(w, std::make_index_sequence<K * L>{});
-  }
-  // Lane k * L + l = -node(l), the offset WindowBuilder adds to the distance.
-  template <class F>
-  static VW node_offsets(F node) {
-    VW v{};
-    for (int j = 0; j < K * L; ++j) v[j] = Real(-node(j % L));  // +0 for node 0, as there
-    return v;
   }
 };
 

@@ -206,11 +206,20 @@ class WindowBuilder {
       origin[d] = G.origin[std::size_t(d)];
       n[d] = G.nodes_per_dim[std::size_t(d)];
     }
-    for (int k = 0; k < W * DP; ++k) {
-      const int d = k / W;  // lane k: direction d, node k % W
-      inv_h_lanes[k / PL][k % PL] = d < D ? inv_h[d] : Real(1);
-      offsets_lanes[k / PL][k % PL] = Real(-(k % W));
-      direction_lanes[k / PL][k % PL] = Real(d);
+    // Each part built in a local and stored whole: lane-by-lane stores into
+    // the members drew a false -Wmaybe-uninitialized from GCC 12 in some
+    // inlining contexts.
+    for (int h = 0; h < kParts; ++h) {
+      Part scale{}, offset{}, direction{};
+      for (int j = 0; j < PL; ++j) {
+        const int k = h * PL + j, d = k / W;  // lane k: direction d, node k % W
+        scale[j] = d < D ? inv_h[d] : Real(1);
+        offset[j] = Real(-(k % W));
+        direction[j] = Real(d);
+      }
+      inv_h_lanes[h] = scale;
+      offsets_lanes[h] = offset;
+      direction_lanes[h] = direction;
     }
   }
 

@@ -796,26 +796,39 @@ void check_packed_matches_one_block(Particles<2, Real> p, std::size_t stop_at) {
   }
 }
 
+// The particle sets of the packed-kernel tests: 6000 random particles in
+// tile order (2 fields, runs of 1-6 per cell), 100 particles of field
+// `crowded_field` in one cell (a run across 4 batches of 32), and the
+// sorted set with particle `bad` off the grid.
+template <class Real>
+struct PackedTestSets {
+  static constexpr std::size_t bad = 1235;
+  Grid<2, Real> g{grid_cells<2>(), 2};
+  Particles<2, Real> sorted, crowded, off_grid;
+  PackedTestSets(unsigned seed, std::uint8_t crowded_field) {
+    TileLayout<2> tiles;
+    tiles.setup(4, g.cells);
+    auto random = random_particles<2, Real>(g.G, g.cells, 6000, seed);
+    sorted = random.permuted(sort_by_tile(random, g.G, tiles));
+    crowded = random_particles<2, Real>(g.G, g.cells, 100, seed + 1);
+    for (std::size_t i = 0; i < crowded.n; ++i) {
+      crowded.field[i] = crowded_field;
+      for (int d = 0; d < 2; ++d)
+        crowded.x[d][i] =
+            Real(double(g.G.origin[d]) + (5.3 + 0.4 * double(i % 7) / 7.0) * double(g.G.h[d]));
+    }
+    off_grid = sorted;
+    off_grid.x[1][bad] = Real(1e6);
+  }
+};
+
 template <class Real>
 void check_packed_all_quantities() {
   static_assert(packed_particles<2, LinearShape, Real>() > 1);
-  Grid<2, Real> g(grid_cells<2>(), 2);
-  TileLayout<2> tiles;
-  tiles.setup(4, g.cells);
-  auto random = random_particles<2, Real>(g.G, g.cells, 6000, 911);
-  auto sorted = random.permuted(sort_by_tile(random, g.G, tiles));
-  auto crowded = random_particles<2, Real>(g.G, g.cells, 100, 912);
-  for (std::size_t i = 0; i < crowded.n; ++i) {
-    crowded.field[i] = 1;
-    for (int d = 0; d < 2; ++d)
-      crowded.x[d][i] =
-          Real(double(g.G.origin[d]) + (5.3 + 0.4 * double(i % 7) / 7.0) * double(g.G.h[d]));
-  }
-  auto off_grid = sorted;
-  const std::size_t bad = 1235;
-  off_grid.x[1][bad] = Real(1e6);
-  for (const auto* list : {&sorted, &crowded, &off_grid}) {
-    const std::size_t stop_at = list == &off_grid ? bad : SIZE_MAX;
+  const PackedTestSets<Real> t(911, 1);
+  const std::size_t bad = t.bad;
+  for (const auto* list : {&t.sorted, &t.crowded, &t.off_grid}) {
+    const std::size_t stop_at = list == &t.off_grid ? bad : SIZE_MAX;
     check_packed_matches_one_block<Real, kAll, true, true>(*list, stop_at);
     check_packed_matches_one_block<Real, kMassMomentum | kForce, false, false>(*list, stop_at);
     check_packed_matches_one_block<Real, kMassMomentum | kForce, true, true>(*list, stop_at);
@@ -1006,6 +1019,92 @@ TYPED_TEST(P2G, FusedMuslTransferMatchesSeparatePassesWindowed) {
 TYPED_TEST(P2G, FusedMuslTransferMatchesSeparatePassesPointwise) {
   check_fused_musl<TypeParam::D, typename TypeParam::Shape, typename TypeParam::Real, false>(602);
 }
+
+// The packed 2D linear gather (kernels/g2p_packed.hpp, what g2p_range runs
+// for 2D linear without the momentum scatter) against the one-particle
+// windowed gather: the gathered values are the same operations in the same
+// order, so L, which is stored as gathered, must be bitwise equal; v, x and
+// x_next are computed from them by the same code at another call site,
+// where -ffp-contract=fast may fuse a multiply-add differently: 2 ulp.
+// Passes: motion + gradient (traction and gravity work, one rigid field),
+// motion into x_next, gradient + commit. Particles: tile-sorted random
+// (2 fields, runs of 1-6), 100 in one cell (a run across 4 batches of 32),
+// the sorted set with one particle off the grid (both report it), and
+// particles spread to the grid's edges.
+template <class Real, unsigned What>
+void check_packed_gather(Particles<2, Real> a, std::size_t bad, bool x_next, unsigned seed) {
+  Grid<2, Real> g(grid_cells<2>(), 2);
+  RandomGridVelocity<2, Real> gv(g.G.nodes * 2, seed);
+  const std::size_t n = a.n;
+  auto b = a;
+  std::array<std::vector<Real>, 4> La, Lb;
+  std::array<std::vector<Real>, 2> xa, xb;
+  auto Pa = a.view(false), Pb = b.view(false);
+  for (int c = 0; c < 4; ++c) {
+    La[std::size_t(c)].assign(n, 0), Lb[std::size_t(c)].assign(n, 0);
+    Pa.L[c] = La[std::size_t(c)].data(), Pb.L[c] = Lb[std::size_t(c)].data();
+  }
+  for (int d = 0; d < 2; ++d) {
+    xa[std::size_t(d)] = a.x[d], xb[std::size_t(d)] = b.x[d];  // what a motion pass wrote
+    if (x_next) Pa.x_next[d] = xa[std::size_t(d)].data(), Pb.x_next[d] = xb[std::size_t(d)].data();
+  }
+  const unsigned char rigid[2] = {0, 1};
+  const double rigid_velocity[2][3] = {{0, 0, 0}, {0.25, -0.5, 0}};
+  G2PParams q;
+  q.dt = 0.01;
+  q.flip = 0.9;
+  q.rigid = rigid;
+  q.rigid_velocity = rigid_velocity;
+  q.body_accel[1] = -9.81;
+  const auto ra = g2p_range_packed<Real, What, true, true, true>(Pa, g.G, gv.V, q, NoKeys{}, 0, n,
+                                                                 NoStressUpdate{});
+  const auto rb = g2p_range_impl<2, LinearShape, Real, What, true, true, true, true>(
+      Pb, g.G, gv.V, q, NoKeys{}, 0, n);
+  ASSERT_EQ(ra.bad, rb.bad);
+  ASSERT_EQ(ra.bad, bad);
+  const double eps = double(std::numeric_limits<Real>::epsilon());
+  auto close = [&](const std::vector<Real>& u, const std::vector<Real>& w, const char* what) {
+    for (std::size_t i = 0; i < n; ++i)
+      ASSERT_LE(std::abs(double(u[i]) - double(w[i])), 2 * eps * (1 + std::abs(double(w[i]))))
+          << what << ", particle " << i << " (What " << What << ")";
+  };
+  for (int c = 0; c < 4; ++c)
+    EXPECT_TRUE(bitwise_equal(La[std::size_t(c)], Lb[std::size_t(c)])) << "L " << c;
+  for (int d = 0; d < 2; ++d) {
+    close(a.v[d], b.v[d], "v");
+    close(a.x[d], b.x[d], "x");
+    close(xa[std::size_t(d)], xb[std::size_t(d)], "x_next");
+  }
+  EXPECT_NEAR(ra.external_work, rb.external_work, 1e3 * eps * (1 + std::abs(rb.external_work)));
+  if constexpr ((What & kUpdateMotion) != 0) {
+    EXPECT_NE(rb.external_work, 0.0);
+  }
+}
+
+template <class Real>
+void check_packed_gather_all() {
+  static_assert(packed_particles<2, LinearShape, Real>() > 1);
+  const PackedTestSets<Real> t(921, 0);
+  auto edges = t.sorted;
+  spread_to_edges<2, LinearShape, Real>(edges, t.g.G, 923);
+  unsigned seed = 930;
+  const Particles<2, Real>* const lists[] = {&t.sorted, &t.crowded, &t.off_grid, &edges};
+  for (const auto* list : lists) {
+    const std::size_t expect = list == &t.off_grid ? t.bad : SIZE_MAX;
+    check_packed_gather<Real, kUpdateMotion | kVelocityGradient>(*list, expect, false, ++seed);
+    check_packed_gather<Real, kUpdateMotion>(*list, expect, true, ++seed);
+    check_packed_gather<Real, kVelocityGradient | kCommitPosition>(*list, expect, true, ++seed);
+  }
+}
+
+#ifdef __AVX512F__
+TEST(PackedLinearGather, MatchesTheOneParticleGatherDouble) {
+  check_packed_gather_all<double>();
+}
+TEST(PackedLinearGather, MatchesTheOneParticleGatherFloat) {
+  check_packed_gather_all<float>();
+}
+#endif
 
 // TileSchedule::share: for 1 to 4 threads, the threads' shares of every
 // color are contiguous, disjoint and cover the color's tiles in order, and

@@ -1,0 +1,110 @@
+// One particle's side of G2P (ALGORITHM §2 step 6), shared by the
+// one-particle gather (kernels/g2p.hpp) and the packed 2D linear one
+// (kernels/g2p_packed.hpp): what a pass computes, and the particle's update
+// from the grid velocity, velocity change and velocity gradient gathered
+// for it.
+#pragma once
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+
+#include "kernels/particle_view.hpp"
+
+namespace mmpm {
+
+enum G2PWhat : unsigned {
+  kUpdateMotion = 1u,      // v and x (x_next under MUSL)
+  kVelocityGradient = 2u,  // L = sum v_i (x) G_ip
+  // MUSL's fused passes (Stepper::step): the new particle momentum m v goes
+  // straight back to the grid momentum with the same weights (the second
+  // transfer), so the caller must run tiles color by color like P2G; and
+  // the velocity-gradient pass moves x to x_next when it is done with x.
+  kScatterMomentum = 4u,
+  kCommitPosition = 8u,
+  // With kVelocityGradient: the constitutive update of each particle right
+  // after its L (the StressFn argument), instead of a pass of its own.
+  kStressUpdate = 16u,
+};
+
+struct G2PParams {
+  double dt = 0;
+  double flip = 1;
+  const unsigned char* rigid = nullptr;         // per field
+  const double (*rigid_velocity)[3] = nullptr;  // per field, at t + dt
+  double body_accel[3] = {0, 0, 0};             // for the external work of gravity
+};
+
+// Outcome of a G2P range: first bad particle (stencil off the grid or
+// non-finite velocity), work of external forces, particles that changed tile.
+struct G2PRangeResult {
+  std::size_t bad = SIZE_MAX;
+  std::size_t unsound = SIZE_MAX;  // kStressUpdate: first particle with J <= 0 or non-finite stress
+  double external_work = 0;
+  bool moved_tile = false;
+};
+
+namespace detail {
+
+// Prescribed motion (ALGORITHM §7): a particle of a rigid field moves with
+// its field's velocity. True when p is one (the pass then skips the rest of
+// its update, as the gathered values do not apply).
+template <int D, class Real, unsigned What, bool MultiField>
+[[gnu::always_inline]] inline bool rigid_motion(const ParticleView<D, Real>& P, const G2PParams& q,
+                                                Real dt, std::size_t p) {
+  if constexpr ((What & kUpdateMotion) != 0 && MultiField) {
+    const int field = int(P.field[p]);
+    if (q.rigid && q.rigid[field]) {
+      for (int d = 0; d < D; ++d) {
+        P.v[d][p] = Real(q.rigid_velocity[field][d]);
+        if (P.x_next[0])
+          P.x_next[d][p] = P.x[d][p] + dt * P.v[d][p];
+        else
+          P.x[d][p] += dt * P.v[d][p];
+      }
+      return true;
+    }
+  }
+  return false;
+}
+
+// Particle p's update from vn (grid velocity), dv (its change over the
+// step) and L (row-major dv_a/dx_b) gathered for it: FLIP/PIC velocity,
+// position (or x_next), the work of external forces, L, the fused stress
+// update and the position commit, as What asks.
+template <int D, class Real, unsigned What, bool Traction, bool Gravity, class StressFn>
+[[gnu::always_inline]] inline void update_particle(const ParticleView<D, Real>& P,
+                                                   const G2PParams& q, Real dt, Real flip, Real pic,
+                                                   std::size_t p, const Real* vn, const Real* dv,
+                                                   const Real* L, G2PRangeResult& r,
+                                                   const StressFn& stress) {
+  if constexpr ((What & kUpdateMotion) != 0) {
+    bool finite = true;
+    double work = 0;
+    for (int d = 0; d < D; ++d) {
+      const Real vnew = flip * (P.v[d][p] + dv[d]) + pic * vn[d];
+      P.v[d][p] = vnew;
+      if (P.x_next[0])
+        P.x_next[d][p] = P.x[d][p] + dt * vn[d];
+      else
+        P.x[d][p] += dt * vn[d];
+      finite = finite && std::isfinite(vnew);
+      // Work = force times the displacement of the material point, which
+      // moves with the grid velocity (not with its FLIP velocity).
+      const double vmove = double(vn[d]);
+      if constexpr (Traction) work += double(P.fext[d][p]) * vmove;
+      if constexpr (Gravity) work += double(P.m[p]) * q.body_accel[d] * vmove;
+    }
+    if constexpr (Traction || Gravity) r.external_work += work * q.dt;
+    if (!finite && r.bad == SIZE_MAX) r.bad = p;
+  }
+  if constexpr ((What & kVelocityGradient) != 0)
+    for (int c = 0; c < D * D; ++c) P.L[c][p] = L[c];
+  if constexpr ((What & kStressUpdate) != 0)
+    if (!stress(P, p) && r.unsound == SIZE_MAX) r.unsound = p;
+  if constexpr ((What & kCommitPosition) != 0)
+    for (int d = 0; d < D; ++d) P.x[d][p] = P.x_next[d][p];
+}
+
+}  // namespace detail
+}  // namespace mmpm
