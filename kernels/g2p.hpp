@@ -257,10 +257,11 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
 
 // The solver's G2P: packed for 2D linear float without the momentum
 // scatter (kernels/g2p_packed.hpp, the same sums), else windowed, and
-// pointwise (node by node) only for grids too small for a window. 2D linear was pointwise while its
-// windows were built particle by particle (12.7 vs 13.6 ns/particle); with the windows built a
-// batch at a time (WindowBuilder::build_batch) the window wins there too (docs/performance.md
-// "Windows a batch at a time, across particles").
+// pointwise (node by node) only for grids too small for a window. 2D
+// linear was pointwise while its windows were built particle by particle
+// (12.7 vs 13.6 ns/particle); with the windows built a batch at a time
+// (WindowBuilder::build_batch) the window wins there too
+// (docs/performance.md "Windows a batch at a time, across particles").
 template <int D, class Shape, class Real, unsigned What, bool MultiField, bool Traction,
           bool Gravity, class KeyFn, class StressFn = NoStressUpdate>
 G2PRangeResult g2p_range(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
