@@ -60,7 +60,6 @@ G2PRangeResult g2p_range_packed(const ParticleView<2, Real>& particles,
   using PL = PackedLinearLanes<Real, K>;
   using Win = typename PL::Win;
   using VW = typename PL::VW;
-  using S = typename PL::S;
   // Local copies of the views, as g2p_range_impl.
   const ParticleView<2, Real> P = particles;
   const GridView<2, Real> G = grid;
@@ -70,32 +69,26 @@ G2PRangeResult g2p_range_packed(const ParticleView<2, Real>& particles,
   const WindowBuilder<2, LinearShape, Real> builder(G);
   const auto off = Win::offsets(G);
   const Real inv_hx = builder.inverse_spacing(0), inv_hy = builder.inverse_spacing(1);
-  constexpr std::size_t N = kWeightBatch + K;  // K finite lanes past any batch
-  Real dist[2][N];
-  std::uint64_t base[N];
-  int inside[N];
+  PackedBatch<Real, K, MultiField> batch;
   for (std::size_t first = begin; first < end; first += kWeightBatch) {
     const std::size_t n = std::min(kWeightBatch, end - first);
-    builder.locate_batch(P, first, n, dist, base, inside);
-    for (int d = 0; d < 2; ++d)
-      for (int k = 0; k < K; ++k) dist[d][n + std::size_t(k)] = Real(0);
+    batch.locate(builder, P, first, n);
     for (std::size_t i = 0; i < n;) {
-      if (!inside[i]) {  // the stencil leaves the grid: the step fails on it
+      if (!batch.inside[i]) {  // the stencil leaves the grid: the step fails on it
         if (r.bad == SIZE_MAX) r.bad = first + i;
         ++i;
         continue;
       }
       // A run: consecutive particles with this window and field.
-      const std::size_t b = base[i] + field_offset<MultiField>(P, G, first + i);
-      std::size_t j = i + 1;
-      while (j < n && inside[j] && base[j] + field_offset<MultiField>(P, G, first + j) == b) ++j;
+      const std::size_t b = batch.window(P, G, i);
+      const std::size_t j = batch.run_end(P, G, i, b, n);
       VW vel[2], dvel[2];
       for (int d = 0; d < 2; ++d) {
         vel[d] = PL::repeat(Win::template load<0>(V.vel[d] + b, off));
         if constexpr (kMotion) dvel[d] = PL::repeat(Win::template load<0>(V.dvel[d] + b, off));
       }
       for (std::size_t k = i; k < j; k += std::size_t(K)) {
-        const PL w = PL::of(lanes_load<S>(&dist[0][k]), lanes_load<S>(&dist[1][k]), inv_hx, inv_hy);
+        const PL w = PL::of(batch.dx(k), batch.dy(k), inv_hx, inv_hy);
         // Lanes 4c .. 4c + 3 of sums[d]: slot c's vn, dv, L_d,x, L_d,y
         // (G2PGather::gather's lanes_sum4, slot by slot).
         VW sums[2];

@@ -164,31 +164,24 @@ std::size_t p2g_range_packed(const ParticleView<2, Real>& particles, const GridV
   static_assert(K > 1);
   using Block = PackedLinearBlock<Real, What, Traction, K>;
   using Source = typename Block::Source;
-  using S = typename Block::S;
   const ParticleView<2, Real> P = particles;  // local copies, as p2g_range_one_block
   const GridView<2, Real> G = grid;
   const WindowBuilder<2, LinearShape, Real> builder(G);
   const auto off = Block::Win::offsets(G);
   const Real inv_t = Real(opt.inv_thickness);
   const Real inv_hx = builder.inverse_spacing(0), inv_hy = builder.inverse_spacing(1);
-  constexpr std::size_t N = kWeightBatch + K;  // K finite lanes past any batch
-  Real r[2][N];
-  std::uint64_t base[N];
-  int inside[N];
+  PackedBatch<Real, K, MultiField> batch;
   Block carried;  // current == SIZE_MAX: nothing carried
   for (std::size_t first = begin; first < end; first += kWeightBatch) {
     const std::size_t n = std::min(kWeightBatch, end - first);
-    builder.locate_batch(P, first, n, r, base, inside);
-    for (int d = 0; d < 2; ++d)
-      for (int k = 0; k < K; ++k) r[d][n + std::size_t(k)] = Real(0);
+    batch.locate(builder, P, first, n);
     for (std::size_t i = 0; i < n;) {
-      if (!inside[i]) {
+      if (!batch.inside[i]) {
         carried.flush(G, off);
         return first + i;
       }
-      const std::size_t b = base[i] + field_offset<MultiField>(P, G, first + i);
-      std::size_t j = i + 1;
-      while (j < n && inside[j] && base[j] + field_offset<MultiField>(P, G, first + j) == b) ++j;
+      const std::size_t b = batch.window(P, G, i);
+      const std::size_t j = batch.run_end(P, G, i, b, n);
       Block block;
       if (carried.current == b)
         block = carried;
@@ -198,10 +191,10 @@ std::size_t p2g_range_packed(const ParticleView<2, Real>& particles, const GridV
       block.current = b;
       std::size_t k = i;
       for (; k + std::size_t(K) <= j; k += std::size_t(K))
-        block.accumulate(lanes_load<S>(&r[0][k]), lanes_load<S>(&r[1][k]), inv_hx, inv_hy,
+        block.accumulate(batch.dx(k), batch.dy(k), inv_hx, inv_hy,
                          Source::template make<true>(P, opt, inv_t, first + k, K));
       if (k < j)
-        block.accumulate(lanes_load<S>(&r[0][k]), lanes_load<S>(&r[1][k]), inv_hx, inv_hy,
+        block.accumulate(batch.dx(k), batch.dy(k), inv_hx, inv_hy,
                          Source::template make<false>(P, opt, inv_t, first + k, int(j - k)));
       if (j == n && first + n < end)
         carried = block;  // the run may go on in the next batch

@@ -14,11 +14,13 @@
 #include <immintrin.h>
 
 #include <cstddef>
+#include <cstdint>
 #include <type_traits>
 #include <utility>
 
 #include "kernels/shape.hpp"
 #include "kernels/window.hpp"
+#include "kernels/window_block.hpp"
 
 namespace mmpm {
 
@@ -138,6 +140,48 @@ struct PackedLinearLanes {
     for (int j = 0; j < N; ++j) v[j] = Real(-node(j % L));  // +0 for node 0, as there
     return v;
   }
+};
+
+// One batch of the packed kernels, located: each particle's distances to
+// its window base (cell units), the base and whether its stencil stays on
+// the grid (WindowBuilder::locate_batch), plus K zero distances past the
+// batch so that a group of K read at a run's end stays finite. Particles
+// come in runs of one window and field (consecutive in tile order).
+template <class Real, int K, bool MultiField>
+struct PackedBatch {
+  static constexpr std::size_t N = kWeightBatch + K;
+  using S = Lanes<Real, K>;
+  Real dist[2][N];
+  std::uint64_t base[N];
+  int inside[N];
+  std::size_t first = 0;  // the batch's first particle
+
+  // Particles first_particle .. first_particle + n - 1 (n <= kWeightBatch).
+  [[gnu::always_inline]] void locate(const WindowBuilder<2, LinearShape, Real>& builder,
+                                     const ParticleView<2, Real>& P, std::size_t first_particle,
+                                     std::size_t n) {
+    first = first_particle;
+    builder.locate_batch(P, first, n, dist, base, inside);
+    for (int d = 0; d < 2; ++d)
+      for (int k = 0; k < K; ++k) dist[d][n + std::size_t(k)] = Real(0);
+  }
+  // Window base of batch particle i, with its field's offset.
+  [[gnu::always_inline]] std::size_t window(const ParticleView<2, Real>& P,
+                                            const GridView<2, Real>& G, std::size_t i) const {
+    return base[i] + field_offset<MultiField>(P, G, first + i);
+  }
+  // One past the last particle of the run that starts at i (inside, window
+  // b), at most n.
+  [[gnu::always_inline]] std::size_t run_end(const ParticleView<2, Real>& P,
+                                             const GridView<2, Real>& G, std::size_t i,
+                                             std::size_t b, std::size_t n) const {
+    std::size_t j = i + 1;
+    while (j < n && inside[j] && window(P, G, j) == b) ++j;
+    return j;
+  }
+  // Distances of batch particles k .. k + K - 1, one lane each.
+  [[gnu::always_inline]] S dx(std::size_t k) const { return lanes_load<S>(&dist[0][k]); }
+  [[gnu::always_inline]] S dy(std::size_t k) const { return lanes_load<S>(&dist[1][k]); }
 };
 
 }  // namespace mmpm
