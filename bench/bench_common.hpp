@@ -333,31 +333,39 @@ struct Binning {
 };
 
 // ---------------------------------------------------------------- scatters
-// (a) The solver's colored scatter (Stepper::p2g): colors in turn, the tiles
-// of a color in parallel, each tile added straight into the grid.
-// Windowed = false runs the pointwise reference kernel in the same tiles.
-template <int D, class Shape, class Real, unsigned What, bool MultiField, bool Traction,
-          bool Windowed = true>
-std::size_t p2g_colored(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
-                        const P2GOptions& opt, const Binning<D, Real>& B) {
+// The colored pass of the Stepper's scatters (Stepper::p2g, MUSL's fused
+// G2P): colors in turn, the tiles of a color in parallel, each thread its
+// share. range(b, e) runs one tile's particles and returns its first bad
+// particle or SIZE_MAX; the smallest is returned.
+template <class Range>
+std::size_t colored_tiles(const TileSchedule& S, std::size_t n, const Range& range) {
   std::size_t bad = SIZE_MAX;
-  const TileSchedule& S = B.schedule;
   for (std::size_t c = 0; c < S.tiles.size(); ++c) {
     if (S.tiles[c].empty()) continue;
-#pragma omp parallel reduction(min : bad) if (P.n >= kParallelMin)
+#pragma omp parallel reduction(min : bad) if (n >= kParallelMin)
     for (auto [k, last] =
              S.share(c, std::size_t(omp_get_num_threads()), std::size_t(omp_get_thread_num()));
          k < last; ++k) {
       const std::uint32_t t = S.tiles[c][k];
-      const std::size_t b = S.begin[t], e = S.begin[t + 1];
-      const std::size_t r =
-          Windowed
-              ? p2g_range<D, Shape, Real, What, MultiField, Traction>(P, G, opt, b, e)
-              : p2g_range_pointwise<D, Shape, Real, What, MultiField, Traction>(P, G, opt, b, e);
-      if (r != e) bad = std::min(bad, r);
+      bad = std::min(bad, range(std::size_t(S.begin[t]), std::size_t(S.begin[t + 1])));
     }
   }
   return bad;
+}
+
+// (a) The solver's colored scatter (Stepper::p2g), each tile added straight
+// into the grid. Windowed = false runs the pointwise reference kernel in the
+// same tiles.
+template <int D, class Shape, class Real, unsigned What, bool MultiField, bool Traction,
+          bool Windowed = true>
+std::size_t p2g_colored(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
+                        const P2GOptions& opt, const Binning<D, Real>& B) {
+  return colored_tiles(B.schedule, P.n, [&](std::size_t b, std::size_t e) {
+    const std::size_t r =
+        Windowed ? p2g_range<D, Shape, Real, What, MultiField, Traction>(P, G, opt, b, e)
+                 : p2g_range_pointwise<D, Shape, Real, What, MultiField, Traction>(P, G, opt, b, e);
+    return r == e ? SIZE_MAX : r;
+  });
 }
 
 // (b) Serial scatter: one thread, particle order.

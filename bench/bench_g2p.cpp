@@ -52,6 +52,15 @@ G2PFixture<D, Shape, Real>& g2p_fixture() {
   });
 }
 
+// The G2P benchmarks' step parameters: particles drift by ~1e-6 cell per
+// call.
+inline G2PParams g2p_bench_params() {
+  G2PParams q;
+  q.dt = 1e-3;
+  q.flip = 0.99;
+  return q;
+}
+
 // Windowed = false: the pointwise reference gather (kernels/g2p.hpp), the
 // baseline the solver's windowed gather is compared with in the same run.
 template <int D, class Shape, class Real, bool Windowed>
@@ -62,9 +71,7 @@ void bm_g2p(benchmark::State& state, int threads) {
   const GridView<D, Real>& G = fx.grid.G;
   const GridVelocity<D, Real>& V = fx.grid.V;
   constexpr unsigned What = kUpdateMotion | kVelocityGradient;
-  G2PParams q;
-  q.dt = 1e-3;
-  q.flip = 0.99;
+  const G2PParams q = g2p_bench_params();
   // The tile-change test as the Stepper runs it (its KeyFn).
   const auto key_of = PositionTile<D, Real>::of(fx.bins.tiles, G.origin, G.h, P.x);
   const std::size_t n = P.n, chunks = chunk_count(n);
@@ -93,6 +100,43 @@ void bm_g2p(benchmark::State& state, int threads) {
       double(sizeof(Real)) * (4 * D + D * D + (std::is_same_v<Shape, GimpShape> ? D : 0)) + 4.0;
   set_rate(state, "particle_GBps", double(n) * bytes);
   set_rate(state, "Gnode_reads_per_s", double(n) * Stencil<D, Shape, Real>::count);
+  state.counters["threads"] = threads;
+}
+
+// MUSL's fused pass (G2P of the updated velocity + P2G of m v into the
+// zeroed grid momentum, kUpdateMotion | kScatterMomentum), colored tile by
+// tile as the Stepper runs it. Solver = true: g2p_range, the solver's
+// choice (packed in 2D linear, kernels/g2p_packed.hpp); false: the
+// one-particle windowed kernel, the baseline in the same run.
+template <int D, class Shape, class Real, bool Solver>
+void bm_g2p_fused(benchmark::State& state, int threads) {
+  use_threads(threads);
+  auto& fx = g2p_fixture<D, Shape, Real>();
+  const ParticleView<D, Real>& P = fx.S.P;
+  const GridView<D, Real>& G = fx.grid.G;
+  const GridVelocity<D, Real>& V = fx.grid.V;
+  constexpr unsigned What = kUpdateMotion | kScatterMomentum;
+  const G2PParams q = g2p_bench_params();
+  const auto key_of = PositionTile<D, Real>::of(fx.bins.tiles, G.origin, G.h, P.x);
+  std::size_t bad = SIZE_MAX;
+  for (auto _ : state) {
+    for (int d = 0; d < D; ++d) std::fill(G.p[d], G.p[d] + G.nodes, Real(0));
+    bad =
+        std::min(bad, colored_tiles(fx.bins.schedule, P.n, [&](std::size_t b, std::size_t e) {
+                   return (Solver ? g2p_range<D, Shape, Real, What, false, false, false>(
+                                        P, G, V, q, key_of, b, e)
+                                  : g2p_range_impl<D, Shape, Real, What, false, false, false, true>(
+                                        P, G, V, q, key_of, b, e))
+                       .bad;
+                 }));
+    keep(G.p[0]);
+    benchmark::ClobberMemory();
+  }
+  if (bad != SIZE_MAX) {
+    state.SkipWithError("fused G2P: stencil off the grid or non-finite velocity");
+    return;
+  }
+  set_ns_per_particle(state, double(P.n));
   state.counters["threads"] = threads;
 }
 
@@ -160,6 +204,24 @@ void register_g2p_case() {
     }
 }
 
+template <int D, class Shape, class Real>
+void register_g2p_fused_case() {
+  for (const bool solver : {true, false})
+    for (int threads : {1, 2}) {
+      const std::string name = std::string("g2p_fused/dim:") + std::to_string(D) +
+                               "/shape:" + Shape::name + "/real:" + real_name<Real>() +
+                               "/kernel:" + (solver ? "solver" : "one_particle") +
+                               "/threads:" + std::to_string(threads);
+      auto* b = benchmark::RegisterBenchmark(name.c_str(), [threads, solver](benchmark::State& st) {
+        if (solver)
+          bm_g2p_fused<D, Shape, Real, true>(st, threads);
+        else
+          bm_g2p_fused<D, Shape, Real, false>(st, threads);
+      });
+      configure(b->UseRealTime()->Unit(benchmark::kMillisecond), 0.1);
+    }
+}
+
 template <int D, class Real>
 void register_dim_real() {
   register_g2p_case<D, LinearShape, Real>();
@@ -179,6 +241,8 @@ void register_dim_real() {
 }  // namespace
 
 void register_g2p() {
+  register_g2p_fused_case<2, LinearShape, double>();
+  register_g2p_fused_case<2, LinearShape, float>();
   register_dim_real<2, double>();
   register_dim_real<2, float>();
   register_dim_real<3, double>();

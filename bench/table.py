@@ -255,8 +255,11 @@ def kernel_section(R):
     ns = "ns_per_particle"
     out = ["## 2. G2P and constitutive update (ns/particle)", "",
            "G2P: FLIP/PIC velocity, position, velocity gradient and the tile-change test, "
-           "as the Stepper runs it (windowed for every shape); "
-           "pointwise = the node-by-node reference gather. Constitutive: isotropic small-strain "
+           "as the Stepper runs it (packed for 2D linear, windowed for the other shapes); "
+           "pointwise = the node-by-node reference gather. MUSL fused G2P+P2G: MUSL's first "
+           "particle pass (G2P of the new velocity, then P2G of m v with the same window), colored "
+           "as in the step; its reference column is the one-particle windowed kernel. "
+           "Constitutive: isotropic small-strain "
            "update (plane strain in 2D). Same particle blocks as P2G.", ""]
     header = ["kernel", "dim", "shape", "real", "1 thread", "2 threads", "speed-up",
               "GB/s (2t)", "pointwise 1t", "pointwise / solver (1t)"]
@@ -272,6 +275,17 @@ def kernel_section(R):
                     continue
                 rows.append(["G2P", dim + "D", shape, real, fmt(v1), fmt(v2), ratio(v1, v2), fmt(gb),
                              fmt(p1), ratio(p1, v1)])
+            # MUSL's fused pass (G2P + P2G of m v): the solver's kernel vs the
+            # one-particle windowed kernel, both in this run.
+            for shape in SHAPES:
+                want = dict(dim=dim, shape=shape, real=real)
+                v1 = R.value("g2p_fused", ns, kernel="solver", threads=1, **want)
+                v2 = R.value("g2p_fused", ns, kernel="solver", threads=2, **want)
+                o1 = R.value("g2p_fused", ns, kernel="one_particle", threads=1, **want)
+                if v1 is None and v2 is None:
+                    continue
+                rows.append(["MUSL fused G2P+P2G", dim + "D", shape, real, fmt(v1), fmt(v2),
+                             ratio(v1, v2), "–", fmt(o1) + " (one particle)", ratio(o1, v1)])
             v1 = R.value("constitutive", ns, dim=dim, law="isotropic", real=real, threads=1)
             v2 = R.value("constitutive", ns, dim=dim, law="isotropic", real=real, threads=2)
             gb = R.value("constitutive", "particle_GBps", dim=dim, law="isotropic", real=real, threads=2)

@@ -255,8 +255,8 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
   return r;
 }
 
-// The solver's G2P: packed for 2D linear float without the momentum
-// scatter (kernels/g2p_packed.hpp, the same sums), else windowed, and
+// The solver's G2P: packed for 2D linear (kernels/g2p_packed.hpp, the same
+// gathered sums), else windowed, and
 // pointwise (node by node) only for grids too small for a window. 2D
 // linear was pointwise while its windows were built particle by particle
 // (12.7 vs 13.6 ns/particle); with the windows built a batch at a time
@@ -267,7 +267,7 @@ template <int D, class Shape, class Real, unsigned What, bool MultiField, bool T
 G2PRangeResult g2p_range(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
                          const GridVelocity<D, Real>& V, const G2PParams& q, const KeyFn& key_of,
                          std::size_t begin, std::size_t end, const StressFn& stress = {}) {
-  if constexpr (packed_gather_pays<D, Shape, Real>() && (What & kScatterMomentum) == 0)
+  if constexpr (packed_gather_pays<D, Shape, Real>())
     if (Window<D, Shape, Real>::fits(G))
       return g2p_range_packed<Real, What, MultiField, Traction, Gravity>(P, G, V, q, key_of, begin,
                                                                          end, stress);

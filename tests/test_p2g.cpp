@@ -1021,7 +1021,7 @@ TYPED_TEST(P2G, FusedMuslTransferMatchesSeparatePassesPointwise) {
 }
 
 // The packed 2D linear gather (kernels/g2p_packed.hpp, what g2p_range runs
-// for 2D linear without the momentum scatter) against the one-particle
+// for 2D linear) against the one-particle
 // windowed gather: the gathered values are the same operations in the same
 // order, so L, which is stored as gathered, must be bitwise equal; v, x and
 // x_next are computed from them by the same code at another call site,
@@ -1031,9 +1031,15 @@ TYPED_TEST(P2G, FusedMuslTransferMatchesSeparatePassesPointwise) {
 // (2 fields, runs of 1-6), 100 in one cell (a run across 4 batches of 32),
 // the sorted set with one particle off the grid (both report it), and
 // particles spread to the grid's edges.
+//
+// With kScatterMomentum (MUSL's fused pass) the packed kernel scatters m v
+// with the packed scatter's block: its momenta equal the one-particle fused
+// pass's to round-off (another order of sums, conservation_tol) and, bit
+// for bit, p2g_range_packed's kMomentumOnly scatter of the particles it
+// updated (the same groups, lanes and products).
 template <class Real, unsigned What>
 void check_packed_gather(Particles<2, Real> a, std::size_t bad, bool x_next, unsigned seed) {
-  Grid<2, Real> g(grid_cells<2>(), 2);
+  Grid<2, Real> g(grid_cells<2>(), 2), g_one(grid_cells<2>(), 2);
   RandomGridVelocity<2, Real> gv(g.G.nodes * 2, seed);
   const std::size_t n = a.n;
   auto b = a;
@@ -1059,7 +1065,7 @@ void check_packed_gather(Particles<2, Real> a, std::size_t bad, bool x_next, uns
   const auto ra = g2p_range_packed<Real, What, true, true, true>(Pa, g.G, gv.V, q, NoKeys{}, 0, n,
                                                                  NoStressUpdate{});
   const auto rb = g2p_range_impl<2, LinearShape, Real, What, true, true, true, true>(
-      Pb, g.G, gv.V, q, NoKeys{}, 0, n);
+      Pb, g_one.G, gv.V, q, NoKeys{}, 0, n);
   ASSERT_EQ(ra.bad, rb.bad);
   ASSERT_EQ(ra.bad, bad);
   const double eps = double(std::numeric_limits<Real>::epsilon());
@@ -1079,6 +1085,22 @@ void check_packed_gather(Particles<2, Real> a, std::size_t bad, bool x_next, uns
   if constexpr ((What & kUpdateMotion) != 0) {
     EXPECT_NE(rb.external_work, 0.0);
   }
+  if constexpr ((What & kScatterMomentum) != 0) {
+    EXPECT_GT(g.sum(g.G.p[0]) * g.sum(g.G.p[0]), 0.0);
+    for (std::size_t k = 0; k < g.arrays.size(); ++k) {
+      double scale = 0;
+      EXPECT_LE(max_rel_diff(g.arrays[k], g_one.arrays[k], scale), conservation_tol<Real>())
+          << "array " << k;
+    }
+    if (bad == SIZE_MAX) {  // p2g_range_packed stops at a particle off the grid
+      Grid<2, Real> scattered(grid_cells<2>(), 2);
+      ASSERT_EQ(
+          (p2g_range_packed<Real, kMomentumOnly, true, false>(Pa, scattered.G, P2GOptions{}, 0, n)),
+          n);
+      for (std::size_t k = 0; k < g.arrays.size(); ++k)
+        EXPECT_TRUE(bitwise_equal(g.arrays[k], scattered.arrays[k])) << "array " << k;
+    }
+  }
 }
 
 template <class Real>
@@ -1093,7 +1115,50 @@ void check_packed_gather_all() {
     const std::size_t expect = list == &t.off_grid ? t.bad : SIZE_MAX;
     check_packed_gather<Real, kUpdateMotion | kVelocityGradient>(*list, expect, false, ++seed);
     check_packed_gather<Real, kUpdateMotion>(*list, expect, true, ++seed);
+    check_packed_gather<Real, kUpdateMotion | kScatterMomentum>(*list, expect, true, ++seed);
     check_packed_gather<Real, kVelocityGradient | kCommitPosition>(*list, expect, true, ++seed);
+  }
+}
+
+// A grid velocity change of +inf at the node below-left of particle 777:
+// every particle whose window holds the node gets a non-finite velocity,
+// and the packed kernel (its K-lane update, update_group, and its particle
+// by particle update) reports the same first one as the one-particle
+// kernel. Tile-sorted random particles (one field, so whole groups take the
+// K-lane update) and the 100 particles in one cell.
+template <class Real>
+void check_packed_gather_non_finite() {
+  const PackedTestSets<Real> t(941, 0);
+  for (const auto* list : {&t.sorted, &t.crowded}) {
+    Particles<2, Real> a = *list, b = *list;
+    const std::size_t n = a.n, poisoned = std::min<std::size_t>(777, n / 2);
+    for (std::size_t p = 0; p < n; ++p) a.field[p] = b.field[p] = 0;
+    Grid<2, Real> ga(grid_cells<2>(), 2), gb(grid_cells<2>(), 2);
+    RandomGridVelocity<2, Real> gv(ga.G.nodes * 2, 943);
+    std::size_t node = 0, stride = 1;
+    for (int d = 0; d < 2; ++d) {
+      const double c = (double(a.x[d][poisoned]) - double(ga.G.origin[d])) / double(ga.G.h[d]);
+      node += std::size_t(std::floor(c)) * stride;
+      stride *= std::size_t(ga.G.nodes_per_dim[d]);
+    }
+    gv.dvel[1][node] = std::numeric_limits<Real>::infinity();
+    std::array<std::vector<Real>, 2> xa, xb;
+    auto Pa = a.view(false), Pb = b.view(false);
+    for (int d = 0; d < 2; ++d) {
+      xa[std::size_t(d)].assign(n, 0), xb[std::size_t(d)].assign(n, 0);
+      Pa.x_next[d] = xa[std::size_t(d)].data(), Pb.x_next[d] = xb[std::size_t(d)].data();
+    }
+    G2PParams q;
+    q.dt = 0.01;
+    q.flip = 0.9;
+    const auto ra = g2p_range_packed<Real, kUpdateMotion, true, false, false>(
+        Pa, ga.G, gv.V, q, NoKeys{}, 0, n, NoStressUpdate{});
+    const auto rb = g2p_range_impl<2, LinearShape, Real, kUpdateMotion, true, false, false, true>(
+        Pb, gb.G, gv.V, q, NoKeys{}, 0, n);
+    ASSERT_NE(rb.bad, SIZE_MAX);
+    EXPECT_LE(rb.bad, poisoned);
+    EXPECT_EQ(ra.bad, rb.bad);
+    EXPECT_FALSE(std::isfinite(double(a.v[1][ra.bad])));
   }
 }
 
@@ -1103,6 +1168,12 @@ TEST(PackedLinearGather, MatchesTheOneParticleGatherDouble) {
 }
 TEST(PackedLinearGather, MatchesTheOneParticleGatherFloat) {
   check_packed_gather_all<float>();
+}
+TEST(PackedLinearGather, ReportsTheFirstNonFiniteParticleDouble) {
+  check_packed_gather_non_finite<double>();
+}
+TEST(PackedLinearGather, ReportsTheFirstNonFiniteParticleFloat) {
+  check_packed_gather_non_finite<float>();
 }
 #endif
 
