@@ -163,8 +163,15 @@ G2PRangeResult g2p_range_packed(const ParticleView<2, Real>& particles,
       // A run: consecutive particles with this window and field.
       const std::size_t b = batch.window(P, G, i);
       const std::size_t j = batch.run_end(P, G, i, b, n);
-      Block block;
-      if constexpr (kScatter) block = Block::start_run(carried, b, G, off);
+      Block block;  // as in p2g_range_packed
+      if constexpr (kScatter) {
+        if (carried.current == b)
+          block = carried;
+        else
+          carried.flush(G, off);
+        carried.current = SIZE_MAX;
+        block.current = b;
+      }
       VW vel[2], dvel[2];
       for (int d = 0; d < 2; ++d) {
         vel[d] = PL::repeat(Win::template load<0>(V.vel[d] + b, off));
@@ -205,7 +212,12 @@ G2PRangeResult g2p_range_packed(const ParticleView<2, Real>& particles,
         if constexpr (kScatter)  // every particle of the group, rigid ones too (g2p.hpp)
           block.accumulate(w, updated_momenta<Source>(P, first + k, count));
       }
-      if constexpr (kScatter) block.end_run(carried, j == n && first + n < end, G, off);
+      if constexpr (kScatter) {
+        if (j == n && first + n < end)
+          carried = block;  // the run may go on in the next batch
+        else
+          block.flush(G, off);
+      }
       i = j;
     }
   }
