@@ -100,13 +100,9 @@ template <class Real, unsigned What, bool Traction, bool Gravity, int K, class V
         }
     if constexpr (Traction || Gravity)
       for (int c = 0; c < K; ++c) {
-        double work = 0;
-        for (int d = 0; d < 2; ++d) {
-          const double vmove = double(vn[d][c]);
-          if constexpr (Traction) work += double(P.fext[d][p + std::size_t(c)]) * vmove;
-          if constexpr (Gravity) work += double(P.m[p + std::size_t(c)]) * q.body_accel[d] * vmove;
-        }
-        r.external_work += work * q.dt;
+        const Real vn_c[2] = {vn[0][c], vn[1][c]};
+        r.external_work +=
+            detail::external_work<2, Real, Traction, Gravity>(P, q, p + std::size_t(c), vn_c);
       }
   }
   if constexpr ((What & kVelocityGradient) != 0)

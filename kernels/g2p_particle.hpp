@@ -68,6 +68,22 @@ template <int D, class Real, unsigned What, bool MultiField>
   return false;
 }
 
+// The work of the external forces (traction, gravity) on particle p over
+// the step: force times the displacement of the material point, which
+// moves with the grid velocity vn (not with its FLIP velocity).
+template <int D, class Real, bool Traction, bool Gravity>
+[[gnu::always_inline]] inline double external_work(const ParticleView<D, Real>& P,
+                                                   const G2PParams& q, std::size_t p,
+                                                   const Real* vn) {
+  double work = 0;
+  for (int d = 0; d < D; ++d) {
+    const double vmove = double(vn[d]);
+    if constexpr (Traction) work += double(P.fext[d][p]) * vmove;
+    if constexpr (Gravity) work += double(P.m[p]) * q.body_accel[d] * vmove;
+  }
+  return work * q.dt;
+}
+
 // Particle p's update from vn (grid velocity), dv (its change over the
 // step) and L (row-major dv_a/dx_b) gathered for it: FLIP/PIC velocity,
 // position (or x_next), the work of external forces, L, the fused stress
@@ -80,7 +96,6 @@ template <int D, class Real, unsigned What, bool Traction, bool Gravity, class S
                                                    const StressFn& stress) {
   if constexpr ((What & kUpdateMotion) != 0) {
     bool finite = true;
-    double work = 0;
     for (int d = 0; d < D; ++d) {
       const Real vnew = flip * (P.v[d][p] + dv[d]) + pic * vn[d];
       P.v[d][p] = vnew;
@@ -89,13 +104,9 @@ template <int D, class Real, unsigned What, bool Traction, bool Gravity, class S
       else
         P.x[d][p] += dt * vn[d];
       finite = finite && std::isfinite(vnew);
-      // Work = force times the displacement of the material point, which
-      // moves with the grid velocity (not with its FLIP velocity).
-      const double vmove = double(vn[d]);
-      if constexpr (Traction) work += double(P.fext[d][p]) * vmove;
-      if constexpr (Gravity) work += double(P.m[p]) * q.body_accel[d] * vmove;
     }
-    if constexpr (Traction || Gravity) r.external_work += work * q.dt;
+    if constexpr (Traction || Gravity)
+      r.external_work += external_work<D, Real, Traction, Gravity>(P, q, p, vn);
     if (!finite && r.bad == SIZE_MAX) r.bad = p;
   }
   if constexpr ((What & kVelocityGradient) != 0)
