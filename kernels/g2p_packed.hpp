@@ -24,6 +24,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
+#include <type_traits>
 #include <utility>
 
 #include "kernels/g2p_particle.hpp"
@@ -87,8 +88,17 @@ template <class Real, unsigned What, bool Traction, bool Gravity, int K, class V
       const S dv = lanes_pick<K>(sums[d], [](int c) { return 4 * c + 1; });
       vnew[d] = flip * (lanes_load<S>(P.v[d] + p) + dv) + pic * vn[d];
       lanes_store(P.v[d] + p, vnew[d]);
-      const S x = lanes_load<S>(P.x[d] + p) + dt * vn[d];
-      lanes_store(P.x_next[0] ? P.x_next[d] + p : P.x[d] + p, x);
+      // detail::move_particle, K lanes at once
+      const S x = lanes_load<S>(P.x[d] + p);
+      S moved;
+      if (std::is_same_v<Real, float> && P.xlo[0]) {
+        S lo = lanes_load<S>(P.xlo[d] + p);
+        moved = compensated_add(x, lo, dt * vn[d]);
+        lanes_store(P.xlo[d] + p, lo);
+      } else {
+        moved = x + dt * vn[d];
+      }
+      lanes_store(P.x_next[0] ? P.x_next[d] + p : P.x[d] + p, moved);
     }
     // Finite: v - v is 0 for finite v, NaN for inf and NaN.
     const S zero = (vnew[0] - vnew[0]) + (vnew[1] - vnew[1]);

@@ -8,8 +8,10 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <type_traits>
 
 #include "kernels/particle_view.hpp"
+#include "kernels/position_sum.hpp"
 
 namespace mmpm {
 
@@ -46,6 +48,20 @@ struct G2PRangeResult {
 
 namespace detail {
 
+// Particle p moved by dt v on axis d: into x_next under MUSL, else into x.
+// In float with xlo, the sum keeps its rounding error (kernels/position_sum.hpp).
+template <int D, class Real>
+[[gnu::always_inline]] inline void move_particle(const ParticleView<D, Real>& P, int d,
+                                                 std::size_t p, Real move) {
+  Real& to = P.x_next[0] ? P.x_next[d][p] : P.x[d][p];
+  if constexpr (std::is_same_v<Real, float>)
+    if (P.xlo[0]) {
+      to = compensated_add(P.x[d][p], P.xlo[d][p], move);
+      return;
+    }
+  to = P.x[d][p] + move;
+}
+
 // Prescribed motion (ALGORITHM §7): a particle of a rigid field moves with
 // its field's velocity. True when p is one (the pass then skips the rest of
 // its update, as the gathered values do not apply).
@@ -57,10 +73,7 @@ template <int D, class Real, unsigned What, bool MultiField>
     if (q.rigid && q.rigid[field]) {
       for (int d = 0; d < D; ++d) {
         P.v[d][p] = Real(q.rigid_velocity[field][d]);
-        if (P.x_next[0])
-          P.x_next[d][p] = P.x[d][p] + dt * P.v[d][p];
-        else
-          P.x[d][p] += dt * P.v[d][p];
+        move_particle(P, d, p, dt * P.v[d][p]);
       }
       return true;
     }
@@ -99,10 +112,7 @@ template <int D, class Real, unsigned What, bool Traction, bool Gravity, class S
     for (int d = 0; d < D; ++d) {
       const Real vnew = flip * (P.v[d][p] + dv[d]) + pic * vn[d];
       P.v[d][p] = vnew;
-      if (P.x_next[0])
-        P.x_next[d][p] = P.x[d][p] + dt * vn[d];
-      else
-        P.x[d][p] += dt * vn[d];
+      move_particle(P, d, p, dt * vn[d]);
       finite = finite && std::isfinite(vnew);
     }
     if constexpr (Traction || Gravity)

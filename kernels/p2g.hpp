@@ -41,7 +41,7 @@ std::size_t p2g_range_pointwise(const ParticleView<D, Real>& P, const GridView<D
     if constexpr ((What & kMultimaterial) != 0) {
       area = P.V[p] * (D == 2 ? inv_t : Real(1));
       for (int d = 0; d < D; ++d)
-        mw[d] = mp * (opt.position_separation ? P.x[d][p] : P.x[d][p] - P.x0[d][p]);
+        mw[d] = mp * separation_coordinate(P, opt.position_separation, d, p);
     }
     for (int k = 0; k < st.count; ++k) {
       const std::size_t i = b + st.node[k];

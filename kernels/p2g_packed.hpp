@@ -70,7 +70,10 @@ struct PackedSource {
       q.area = lanes_of<Full>(P.V, p, count) * inv_t;
       for (int d = 0; d < 2; ++d) {
         const S x = lanes_of<Full>(P.x[d], p, count);
-        q.mw[d] = q.m * (opt.position_separation ? x : x - lanes_of<Full>(P.x0[d], p, count));
+        S u = opt.position_separation ? x : x - lanes_of<Full>(P.x0[d], p, count);
+        if constexpr (std::is_same_v<Real, float>)  // separation_coordinate, K lanes
+          if (!opt.position_separation && P.xlo[0]) u += lanes_of<Full>(P.xlo[d], p, count);
+        q.mw[d] = q.m * u;
       }
     }
     return q;

@@ -21,7 +21,11 @@ struct ParticleView {
   Real* V = nullptr;                            // current volume (area * thickness in 2D)
   std::array<Real*, kStressComponents<D>> s{};  // Cauchy stress
   std::array<Real*, D * D> L{};                 // velocity gradient from G2P, row-major dv_a/dx_b
-  std::array<Real*, D * D> F{};   // deformation gradient (finite-strain materials only)
+  // Displacement gradient H = F - I, row-major (finite-strain materials
+  // only). Stored instead of F so that small strains keep the precision of
+  // Real: F's entries are ~1, and a float F lost strain increments below
+  // 6e-8 (kernels/constitutive.hpp NeoHookeanPoint).
+  std::array<Real*, D * D> H{};
   std::array<Real*, D> x0{};      // initial position (displacement output / separation)
   std::array<Real*, D> lp{};      // uGIMP half-width in cell units (gimp only)
   std::array<Real*, D> fext{};    // external (traction) force (only with traction loads)
@@ -32,6 +36,9 @@ struct ParticleView {
   // and the velocity gradient still use the shape functions of the step's
   // start (Sulsky's MUSL); the stepper copies them into x afterwards.
   std::array<Real*, D> x_next{};
+  // float only: the low part of x, what x could not hold of the moves so far
+  // (kernels/position_sum.hpp); the position is x + xlo. Null in double.
+  std::array<Real*, D> xlo{};
 };
 
 }  // namespace mmpm

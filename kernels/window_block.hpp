@@ -8,6 +8,7 @@
 
 #include "kernels/grid_view.hpp"
 #include "kernels/particle_view.hpp"
+#include "kernels/position_sum.hpp"
 #include "kernels/window.hpp"
 
 namespace mmpm {
@@ -57,7 +58,7 @@ template <int D, class Real, unsigned What, bool Traction>
   if constexpr ((What & kMultimaterial) != 0) {
     q.area = P.V[p] * (D == 2 ? inv_t : Real(1));
     for (int d = 0; d < D; ++d)
-      q.mw[d] = q.m * (opt.position_separation ? P.x[d][p] : P.x[d][p] - P.x0[d][p]);
+      q.mw[d] = q.m * separation_coordinate(P, opt.position_separation, d, p);
   }
   return q;
 }

@@ -1054,6 +1054,24 @@ void check_packed_gather(Particles<2, Real> a, std::size_t bad, bool x_next, uns
     xa[std::size_t(d)] = a.x[d], xb[std::size_t(d)] = b.x[d];  // what a motion pass wrote
     if (x_next) Pa.x_next[d] = xa[std::size_t(d)].data(), Pb.x_next[d] = xb[std::size_t(d)].data();
   }
+  // Float: both kernels keep the positions' low parts (kernels/
+  // position_sum.hpp), from the same random start within half an ulp.
+  std::array<std::vector<Real>, 2> loa, lob;
+  const auto x_start = a.x;
+  auto ulp = [](Real x) {
+    return double(std::nextafter(std::abs(x), Real(1e30))) - double(std::abs(x));
+  };
+  if constexpr (std::is_same_v<Real, float>) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> U(-0.5, 0.5);
+    for (int d = 0; d < 2; ++d) {
+      loa[std::size_t(d)].resize(n);
+      for (std::size_t i = 0; i < n; ++i) loa[std::size_t(d)][i] = Real(U(rng) * ulp(a.x[d][i]));
+      lob[std::size_t(d)] = loa[std::size_t(d)];
+      Pa.xlo[d] = loa[std::size_t(d)].data(), Pb.xlo[d] = lob[std::size_t(d)].data();
+    }
+  }
+  const auto lo_start = loa;
   const unsigned char rigid[2] = {0, 1};
   const double rigid_velocity[2][3] = {{0, 0, 0}, {0.25, -0.5, 0}};
   G2PParams q;
@@ -1081,6 +1099,24 @@ void check_packed_gather(Particles<2, Real> a, std::size_t bad, bool x_next, uns
     close(a.x[d], b.x[d], "x");
     close(xa[std::size_t(d)], xb[std::size_t(d)], "x_next");
   }
+  // x + xlo of the two kernels: the same sum of x, xlo and the move, which
+  // differs by the one rounding of the move (2 eps of it) and of move + lo.
+  if constexpr (std::is_same_v<Real, float>)
+    for (int d = 0; d < 2; ++d) {
+      const auto& end_a = x_next ? xa[std::size_t(d)] : a.x[d];
+      const auto& end_b = x_next ? xb[std::size_t(d)] : b.x[d];
+      const auto& la = loa[std::size_t(d)];
+      const auto& lb = lob[std::size_t(d)];
+      for (std::size_t i = 0; i < n; ++i) {
+        const double pa = double(end_a[i]) + double(la[i]), pb = double(end_b[i]) + double(lb[i]);
+        const double start = double(x_start[d][i]) + double(lo_start[std::size_t(d)][i]);
+        const double tol = 4 * eps * (std::abs(pb - start) + ulp(x_start[d][i]));
+        ASSERT_NEAR(pa, pb, tol) << "x + xlo " << d << ", particle " << i << " (What " << What
+                                 << ")";
+        ASSERT_LE(std::abs(double(la[i])), 0.5 * ulp(end_a[i]))
+            << "xlo " << d << ", particle " << i;
+      }
+    }
   EXPECT_NEAR(ra.external_work, rb.external_work, 1e3 * eps * (1 + std::abs(rb.external_work)));
   if constexpr ((What & kUpdateMotion) != 0) {
     EXPECT_NE(rb.external_work, 0.0);

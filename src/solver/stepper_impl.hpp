@@ -96,7 +96,7 @@ void Stepper<D, Shape, Real>::setup_particles(const ParticleSeeds& seeds) {
   for (int c = 0; c < NS; ++c) P_.s[c] = pcols_.add_real("s" + std::to_string(c), n);
   for (int c = 0; c < D * D; ++c) P_.L[c] = pcols_.add_real("L" + std::to_string(c), n);
   if (finite)
-    for (int c = 0; c < D * D; ++c) P_.F[c] = pcols_.add_real("F" + std::to_string(c), n);
+    for (int c = 0; c < D * D; ++c) P_.H[c] = pcols_.add_real("H" + std::to_string(c), n);
   if (need_x0)
     for (int d = 0; d < D; ++d) P_.x0[d] = pcols_.add_real(std::string("x0") + axis[d], n);
   if (scene_.grid.shape == ShapeKind::gimp)
@@ -113,6 +113,13 @@ void Stepper<D, Shape, Real>::setup_particles(const ParticleSeeds& seeds) {
   }
   pcols_.key.allocate(n, pcols_.next_slot++);
   P_.key = pcols_.key.data();
+  // float: the positions' low parts (kernels/position_sum.hpp), after every
+  // other column so those keep their allocation slots (staggered_array.hpp).
+  if constexpr (std::is_same_v<Real, float>)
+    for (int d = 0; d < D && scene_.simulation.compensated_positions; ++d) {
+      P_.xlo[d] = pcols_.add_real(std::string("xlo") + axis[d], n);
+      std::fill(P_.xlo[d], P_.xlo[d] + n, Real(0));
+    }
 
   double min_mass = std::numeric_limits<double>::max();
   for (std::size_t p = 0; p < n; ++p) {
@@ -127,8 +134,8 @@ void Stepper<D, Shape, Real>::setup_particles(const ParticleSeeds& seeds) {
     min_mass = std::min(min_mass, mass);
     P_.m[p] = Real(mass);
     P_.V[p] = Real(seeds.volume[p]);
-    if (P_.F[0])
-      for (int c = 0; c < D * D; ++c) P_.F[c][p] = (c % (D + 1)) == 0 ? Real(1) : Real(0);
+    if (P_.H[0])
+      for (int c = 0; c < D * D; ++c) P_.H[c][p] = Real(0);  // F = I
     P_.mat[p] = std::uint8_t(seeds.material[p]);
     body[p] = std::uint8_t(std::min(seeds.body[p], 255));
     if (P_.field)
@@ -697,7 +704,7 @@ Energies Stepper<D, Shape, Real>::energies() const {
           if (mat.finite_strain()) {
             double F[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
             for (int i = 0; i < D; ++i)
-              for (int j = 0; j < D; ++j) F[i * 3 + j] = double(P_.F[i * D + j][p]);
+              for (int j = 0; j < D; ++j) F[i * 3 + j] += double(P_.H[i * D + j][p]);
             const double J = F[0] * (F[4] * F[8] - F[5] * F[7]) -
                              F[1] * (F[3] * F[8] - F[5] * F[6]) +
                              F[2] * (F[3] * F[7] - F[4] * F[6]);
@@ -756,20 +763,23 @@ template <int D, class Shape, class Real>
 io::ParticleField Stepper<D, Shape, Real>::particle_field(const std::string& name) const {
   const std::size_t n = P_.n;
   io::ParticleField out{name, 1, {}};
-  auto vec = [&](const std::array<Real*, D>& a, const std::array<Real*, D>* minus) {
+  // plus: xlo, the part of the position x does not hold (float only).
+  auto vec = [&](const std::array<Real*, D>& a, const std::array<Real*, D>* minus,
+                 const std::array<Real*, D>& plus) {
     out.components = D;
     out.values.resize(n * D);
     for (std::size_t p = 0; p < n; ++p)
       for (int d = 0; d < D; ++d)
         out.values[p * D + std::size_t(d)] =
-            double(a[d][p]) - (minus ? double((*minus)[d][p]) : 0.0);
+            (double(a[d][p]) - (minus ? double((*minus)[d][p]) : 0.0)) +
+            (plus[0] ? double(plus[d][p]) : 0.0);
   };
   if (name == "position") {
-    vec(P_.x, nullptr);
+    vec(P_.x, nullptr, P_.xlo);
   } else if (name == "displacement") {
-    vec(P_.x, &P_.x0);
+    vec(P_.x, &P_.x0, P_.xlo);
   } else if (name == "velocity") {
-    vec(P_.v, nullptr);
+    vec(P_.v, nullptr, {});
   } else if (name == "stress") {
     out.components = NS;
     out.values.resize(n * NS);
@@ -786,7 +796,7 @@ io::ParticleField Stepper<D, Shape, Real>::particle_field(const std::string& nam
       if (mat.finite_strain()) {
         double F[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
         for (int i = 0; i < D; ++i)
-          for (int j = 0; j < D; ++j) F[i * 3 + j] = double(P_.F[i * D + j][p]);
+          for (int j = 0; j < D; ++j) F[i * 3 + j] += double(P_.H[i * D + j][p]);
         auto C = [&](int i, int j) {
           return F[i] * F[j] + F[3 + i] * F[3 + j] + F[6 + i] * F[6 + j];
         };
@@ -813,13 +823,15 @@ io::ParticleField Stepper<D, Shape, Real>::particle_field(const std::string& nam
       }
     }
   } else if (name == "deformation_gradient") {
-    if (!P_.F[0])
+    if (!P_.H[0])
       throw InputError(
           "output field 'deformation_gradient' needs a finite-strain (neohookean) material");
     out.components = D * D;
     out.values.resize(n * D * D);
     for (std::size_t p = 0; p < n; ++p)
-      for (int c = 0; c < D * D; ++c) out.values[p * D * D + std::size_t(c)] = double(P_.F[c][p]);
+      for (int c = 0; c < D * D; ++c)
+        out.values[p * D * D + std::size_t(c)] =
+            double(P_.H[c][p]) + ((c % (D + 1)) == 0 ? 1.0 : 0.0);  // F = I + H
   } else if (name == "body") {
     out.values.resize(n);
     const std::uint8_t* body = pcols_.byte("body");
