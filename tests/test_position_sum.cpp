@@ -36,7 +36,7 @@ TEST(PositionSum, FloatMovesBelowHalfAnUlpAddUp) {
       if (compensated) P.xlo = {&lo[0], &lo[1]};
       if (into_next) P.x_next = {&next[0], &next[1]};
       for (int k = 0; k < steps; ++k) {
-        detail::move_particle(P, 0, 0, move);
+        detail::move_particle(P, 0, 0, 1.0f, move);
         if (into_next) x[0] = next[0];  // the commit of the gradient pass
       }
       const double end = double(x[0]) + double(lo[0]);
@@ -74,7 +74,7 @@ TEST(PositionSum, FloatWalkReturnsToItsStart) {
   const double eps = double(std::numeric_limits<float>::epsilon());
   double bound = 0;
   auto step = [&](float m) {
-    detail::move_particle(P, 0, 0, m);
+    detail::move_particle(P, 0, 0, 1.0f, m);
     const double ulp = double(std::nextafter(std::abs(x[0]), 1e30f)) - double(std::abs(x[0]));
     EXPECT_LE(std::abs(double(lo[0])), 0.5 * ulp);
     bound += eps * (std::abs(double(m)) + ulp);
