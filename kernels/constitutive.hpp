@@ -254,9 +254,9 @@ struct AnisotropicPoint {
 // small difference of entries ~1, so float kept it to ~1e-7 absolute and
 // lost every increment below half that; near a static state the strain
 // then stopped short and the particles kept moving. The series bars in
-// neo-Hookean, plane strain, h = 0.25 mm, perfect interface, measured the
-// top displacement 3.7x the double run's (docs/performance.md "Strains in
-// float"). In H no term is 1 + small - 1.
+// neo-Hookean (plane strain, h = 0.25 mm, Dn = 10, float positions
+// compensated) measured the top displacement 3.7x the double run's
+// (docs/performance.md "Strains in float"). In H no term is 1 + small - 1.
 template <int D, class Real>
 struct NeoHookeanPoint {
   Real dt = 0, lam = 0, mu = 0, inv_rho = 0;

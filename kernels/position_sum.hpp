@@ -9,9 +9,11 @@
 // (docs/performance.md "Positions in float"). Kept here: lo, the part of
 // each sum that x could not hold, added back into the next move
 // (compensated summation, Kahan 1965; the error term is exact by
-// Dekker's Fast2Sum when |x| >= |move|, Knuth TAOCP vol. 2 §4.2.2). x + lo
-// is then the exact sum of the rounded moves to about 2^-48 of x, at the
-// cost of one array per axis, read and written where x is. Double needs
+// Dekker's Fast2Sum when |x| >= |move + lo|, Knuth TAOCP vol. 2 §4.2.2).
+// x + lo then holds the sum of the moves with an error of at most
+// eps (|move| + ulp(x)) per step, the rounding of move + lo, instead of up
+// to half an ulp of x; the cost is one array per axis, read and written
+// where x is. Double needs
 // none of it (ulp 1.8e-15 mm at 10 mm), so the double kernels never see
 // lo (ParticleView::xlo null).
 #pragma once

@@ -56,7 +56,7 @@ struct SimulationSpec {
   bool fuse_constitutive = false;
   // float only: positions keep their rounding error in a second array
   // (kernels/position_sum.hpp), so a step's move below half an ulp of x
-  // is not lost. false: plain float sums, 5-7 % faster steps whose static
+  // is not lost. false: plain float sums, 3-7 % faster steps whose static
   // displacements stop short (docs/performance.md "Positions in float").
   bool compensated_positions = true;
   // The multimaterial fields (mx, Omega, g) are scattered apart, only from

@@ -769,10 +769,13 @@ io::ParticleField Stepper<D, Shape, Real>::particle_field(const std::string& nam
     out.components = D;
     out.values.resize(n * D);
     for (std::size_t p = 0; p < n; ++p)
-      for (int d = 0; d < D; ++d)
-        out.values[p * D + std::size_t(d)] =
-            (double(a[d][p]) - (minus ? double((*minus)[d][p]) : 0.0)) +
-            (plus[0] ? double(plus[d][p]) : 0.0);
+      for (int d = 0; d < D; ++d) {
+        // No + 0.0 where there is no term: it would turn a -0 into +0.
+        double value = double(a[d][p]);
+        if (minus) value -= double((*minus)[d][p]);
+        if (plus[0]) value += double(plus[d][p]);
+        out.values[p * D + std::size_t(d)] = value;
+      }
   };
   if (name == "position") {
     vec(P_.x, nullptr, P_.xlo);
