@@ -51,6 +51,7 @@ void register_step();
 void register_mm_scene();
 void register_scaling();
 void register_step_pair();
+void register_step_ab();
 
 // The 2D linear one-material scene (bench_scaling.cpp): a square block of
 // `cells` x `cells` cells, 2 x 2 particles per cell, in a grid 4 cells wider.
@@ -72,7 +73,31 @@ std::array<double, 7> set_stage_counters(benchmark::State& state,
 // schemes. The Simulation is the one the step/... benchmarks of that scene
 // (without overrides) step.
 Simulation& step_scene_simulation(const std::string& scene);
+// The same scene with --set style overrides ("simulation.fuse_step_tail=false").
+Simulation& step_scene_simulation(const std::string& scene,
+                                  const std::vector<std::string>& overrides);
 Scheme step_scene_scheme(const std::string& scene);
+
+// Paired blocks (bench_step_pair.cpp, bench_step_ab.cpp): the seconds of one
+// block of timed steps, per stage and (last) for the whole step, after one
+// untimed step.
+using BlockTimes = std::array<double, 8>;
+BlockTimes time_block(Simulation& sim, int steps);
+// Per stage and the whole step ("step"), from blocks x[i] and y[i] of the
+// same pairs: <nx><s> and <ny><s>, the minima in ns per particle per step
+// (`per` = 1e9 / (steps x particles)); <r><s>, the median over the pairs
+// of x / y; <r><s>_min, min x / min y.
+void set_paired_counters(benchmark::State& state, const std::vector<BlockTimes>& x,
+                         const std::vector<BlockTimes>& y, double per, const std::string& nx,
+                         const std::string& ny, const std::string& r);
+
+// The median of a sample (0 for none): the paired benchmarks' statistic.
+inline double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  const std::size_t m = v.size() / 2;
+  return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+}
 
 // dst <- src for an array of fields x nodes, each thread copying the nodes
 // it owns under an even NodeOwnership (kernels/node_ownership.hpp), as the

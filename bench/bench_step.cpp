@@ -309,6 +309,13 @@ Simulation& step_scene_simulation(const std::string& scene) {
   return simulation_for(shared_case(scene));
 }
 
+Simulation& step_scene_simulation(const std::string& scene,
+                                  const std::vector<std::string>& overrides) {
+  StepCase c = shared_case(scene);
+  c.overrides = overrides;
+  return simulation_for(c);
+}
+
 void register_step() {
   const StepCase linear{"2d_linear_1mat", linear_block_scene(250), {}};
   const StepCase interface {
@@ -322,6 +329,12 @@ void register_step() {
   for (int threads : {1, 2})
     add({"2d_linear_1mat", linear_block_scene(250), {"simulation.scheme=\"USL\""}}, threads);
   for (int threads : {1, 2}) add(interface, threads);
+  // MUSL's last particle stages and the next P2G as separate passes
+  // (fuse_step_tail = false), interleaved with the default rows above.
+  for (int threads : {1, 2}) {
+    add({"2d_linear_1mat", linear_block_scene(250), {"simulation.fuse_step_tail=false"}}, threads);
+    add({"2d_gimp_interface", two_layer(true, true), {"simulation.fuse_step_tail=false"}}, threads);
+  }
   // The constitutive update fused into the gradient pass
   // (fuse_constitutive = true), interleaved with the default rows above.
   for (int threads : {1, 2}) {

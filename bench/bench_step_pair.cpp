@@ -30,32 +30,11 @@
 namespace mmpm::bench {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-constexpr int kSteps = 4;               // timed steps per block
-constexpr int kStepPart = kStageCount;  // after the stages: the whole step (wall clock)
-constexpr int kParts = kStageCount + 1;
+constexpr int kSteps = 4;  // timed steps per block
 
-using Times = std::array<double, kParts>;  // seconds of one block, per stage and the step
-
-Times run_block(Simulation& sim, int threads) {
+BlockTimes run_block(Simulation& sim, int threads) {
   use_threads(threads);
-  sim.step();  // untimed: the node split for the new team
-  const auto s0 = sim.stage_seconds();
-  const auto t0 = Clock::now();
-  for (int k = 0; k < kSteps; ++k) sim.step();
-  const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
-  const auto s1 = sim.stage_seconds();
-  Times t{};
-  for (int s = 0; s < kStageCount; ++s) t[std::size_t(s)] = s1[s] - s0[s];
-  t[kStepPart] = wall;
-  return t;
-}
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::sort(v.begin(), v.end());
-  const std::size_t m = v.size() / 2;
-  return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+  return time_block(sim, kSteps);  // its untimed step: the node split for the new team
 }
 
 void bm_step_pair(benchmark::State& state, const std::string& scene) {
@@ -66,33 +45,18 @@ void bm_step_pair(benchmark::State& state, const std::string& scene) {
         use_threads(threads);
         sim.step();
       }
-    std::vector<Times> one, two;
+    std::vector<BlockTimes> one, two;
     for (auto _ : state) {
       const bool one_first = one.size() % 2 == 0;
-      const Times a = run_block(sim, one_first ? 1 : 2);
-      const Times b = run_block(sim, one_first ? 2 : 1);
+      const BlockTimes a = run_block(sim, one_first ? 1 : 2);
+      const BlockTimes b = run_block(sim, one_first ? 2 : 1);
       one.push_back(one_first ? a : b);
       two.push_back(one_first ? b : a);
       benchmark::ClobberMemory();
-      state.SetIterationTime(a[kStepPart] + b[kStepPart]);
+      state.SetIterationTime(a[kStageCount] + b[kStageCount]);
     }
     const double per = 1e9 / (kSteps * double(sim.particle_count()));
-    for (int s = 0; s < kParts; ++s) {
-      if (s == kStageOutput) continue;  // a bench step writes no output
-      std::vector<double> ratios;
-      double min1 = 1e30, min2 = 1e30;
-      for (std::size_t i = 0; i < one.size(); ++i) {
-        const double t1 = one[i][std::size_t(s)], t2 = two[i][std::size_t(s)];
-        min1 = std::min(min1, t1);
-        min2 = std::min(min2, t2);
-        if (t2 > 0) ratios.push_back(t1 / t2);
-      }
-      const std::string n = s == kStepPart ? "step" : bench_stage_name(s);
-      state.counters["ns1_" + n] = min1 * per;
-      state.counters["ns2_" + n] = min2 * per;
-      state.counters["speedup_" + n] = median(ratios);
-      state.counters["speedup_" + n + "_min"] = min2 > 0 ? min1 / min2 : 0.0;
-    }
+    set_paired_counters(state, one, two, per, "ns1_", "ns2_", "speedup_");
     state.counters["pairs"] = double(one.size());
     state.counters["particles"] = double(sim.particle_count());
     state.counters["steps_per_block"] = kSteps;
@@ -102,6 +66,42 @@ void bm_step_pair(benchmark::State& state, const std::string& scene) {
 }
 
 }  // namespace
+
+BlockTimes time_block(Simulation& sim, int steps) {
+  using Clock = std::chrono::steady_clock;
+  sim.step();  // untimed
+  const auto s0 = sim.stage_seconds();
+  const auto t0 = Clock::now();
+  for (int k = 0; k < steps; ++k) sim.step();
+  const double wall = std::chrono::duration<double>(Clock::now() - t0).count();
+  const auto s1 = sim.stage_seconds();
+  BlockTimes t{};
+  static_assert(std::tuple_size_v<BlockTimes> == kStageCount + 1);
+  for (int s = 0; s < kStageCount; ++s) t[std::size_t(s)] = s1[s] - s0[s];
+  t[kStageCount] = wall;
+  return t;
+}
+
+void set_paired_counters(benchmark::State& state, const std::vector<BlockTimes>& x,
+                         const std::vector<BlockTimes>& y, double per, const std::string& nx,
+                         const std::string& ny, const std::string& r) {
+  for (int s = 0; s <= kStageCount; ++s) {
+    if (s == kStageOutput) continue;  // a bench step writes no output
+    std::vector<double> ratios;
+    double min_x = 1e30, min_y = 1e30;
+    for (std::size_t i = 0; i < x.size() && i < y.size(); ++i) {
+      const double a = x[i][std::size_t(s)], b = y[i][std::size_t(s)];
+      min_x = std::min(min_x, a);
+      min_y = std::min(min_y, b);
+      if (b > 0) ratios.push_back(a / b);
+    }
+    const std::string n = s == kStageCount ? "step" : bench_stage_name(s);
+    state.counters[nx + n] = min_x * per;
+    state.counters[ny + n] = min_y * per;
+    state.counters[r + n] = median(ratios);
+    state.counters[r + n + "_min"] = min_y > 0 ? min_x / min_y : 0.0;
+  }
+}
 
 void register_step_pair() {
   for (const char* scene :

@@ -335,9 +335,13 @@ def grid_section(R):
 STEP_SCENES = [
     ("2d_linear_1mat", "2D linear, 1 elastic material"),
     (("2d_linear_1mat", {"scheme": "USL"}), "the same with scheme = USL (one transfer)"),
+    (("2d_linear_1mat", {"fuse_step_tail": "false"}),
+     "the same with the step's tail unfused (fuse_step_tail = false)"),
     (("2d_linear_1mat", {"fuse_constitutive": "true"}),
      "the same with the constitutive update fused into G2P"),
     ("2d_gimp_interface", "2D gimp two-layer, imperfect interface (Dn perfect, Dt 5, SN)"),
+    (("2d_gimp_interface", {"fuse_step_tail": "false"}),
+     "the same with the step's tail unfused (fuse_step_tail = false)"),
     (("2d_gimp_interface", {"fuse_constitutive": "true"}),
      "the same with the constitutive update fused into G2P"),
     (("2d_gimp_interface", {"mm_fields_share": "0.0"}),
@@ -365,8 +369,11 @@ def step_section(R):
     out = ["## 3. Whole step through the Simulation interface (ns/particle/step)", "",
            "make_simulation(parse_scene_text(...)), step() in the loop, the solver's default scheme "
            "(MUSL) unless noted. MUSL runs P2G, then one fused pass (G2P of the updated velocity + "
-           "P2G of the new momenta, timed as g2p) and a G2P of the velocity gradient. Stage columns "
-           "are the Stepper's own timers (1 thread), ns/particle/step.", ""]
+           "P2G of the new momenta, timed as g2p) and a G2P of the velocity gradient; by default "
+           "(fuse_step_tail) that last G2P, the constitutive update and the next step's P2G run "
+           "tile by tile in one pass, whose time the Stepper shares among the g2p, constitutive "
+           "and p2g columns in the proportions thread 0 measured. Stage columns are the Stepper's "
+           "own timers (1 thread), ns/particle/step.", ""]
     header = ["scene", "particles", "fields", "1 thread", "spread", "2 threads", "spread",
               "speed-up"] + [s + " (1t)" for s in STAGES]
     rows = []
@@ -395,7 +402,39 @@ def step_section(R):
                     f"ns/particle/step — measured {fmt(gi)}, {verdict} the target."]
     out += stage_speedup_table(R)
     out += paired_speedup_table(R)
+    out += paired_setting_table(R)
     return out
+
+
+def paired_setting_table(R):
+    """step_ab/... (bench/bench_step_ab.cpp): two Simulations of a scene, A
+    with the defaults and B with one setting changed, alternate blocks of
+    steps on the same threads. Per thread count: the median over the passes
+    of the median paired ratio t(B) / t(A), [the ratio of the minima], (A →
+    B ns/particle/step, minima), and P2G's share likewise."""
+    scenes = [(scene, label) for scene, label, kw in step_scenes() if len(kw) == 1]
+    rows = []
+    for scene, label in scenes:
+        for t in (1, 2):
+            kw = dict(scene=scene, b="fuse_step_tail_false", threads=t)
+            r = R.value("step_ab", "b_over_a_step", stat="median", **kw)
+            if r is None:
+                continue
+            rm = R.value("step_ab", "b_over_a_step_min", stat="median", **kw)
+            a, b = (R.value("step_ab", f"ns{x}_step", stat="min", **kw) for x in "AB")
+            pa, pb = (R.value("step_ab", f"ns{x}_p2g", stat="min", **kw) for x in "AB")
+            rows.append([f"`{scene}`: {label}", str(t), f"{r:.3f} [{rm:.3f}]",
+                         f"{fmt(a)} → {fmt(b)}", f"{fmt(pa, 2)} → {fmt(pb, 2)}"])
+    if not rows:
+        return []
+    return ["", "### The fused step tail, paired blocks (B: fuse_step_tail = false)", "",
+            "`step_ab/scene:.../b:fuse_step_tail_false`: two simulations of the scene, A with the "
+            "defaults (MUSL's gradient G2P, constitutive update and next P2G fused tile by tile) "
+            "and B with the three passes apart, alternate blocks of 4 steps (A,B / B,A / ...; one "
+            "untimed step opens each block). Ratio: median over the pairs of t(B) / t(A) (> 1: "
+            "the fused tail is faster), [ratio of the minima]; ns/particle/step, minima, A → B; "
+            "the p2g column is the stage, in A its measured share of the fused pass.", "",
+            table(["scene", "threads", "B / A", "step A → B", "p2g A → B"], rows)]
 
 
 def paired_speedup_table(R):

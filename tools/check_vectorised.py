@@ -38,7 +38,9 @@ RULES = [
     # divides and fmas; as scalar code it has none.
     (r"^void mmpm::detail::node_velocities<", 2, None,
      "grid velocities (kernels/grid_update.hpp)"),
-    (r"^mmpm::Stepper<\d, mmpm::\w+, (float|double)>::constitutive\(\) \[clone \._omp_fn", 30,
+    # The per-material loops of one range: the constitutive pass's threads
+    # and the fused step tail's tiles call it (solver/stepper_impl.hpp).
+    (r"^mmpm::Stepper<\d, mmpm::\w+, (float|double)>::constitutive_range\(unsigned long, unsigned long\)$", 30,
      None, "constitutive update loops (kernels/constitutive.hpp)"),
 ]
 

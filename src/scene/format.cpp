@@ -116,6 +116,7 @@ void write_simulation(Writer& w, const Scene& s) {
   w.boolean("force", sim.force);
   w.integer("sort_every", sim.sort_every);
   w.boolean("fuse_constitutive", sim.fuse_constitutive);
+  w.boolean("fuse_step_tail", sim.fuse_step_tail);
   w.boolean("compensated_positions", sim.compensated_positions);
   w.num("mm_fields_share", sim.mm_fields_share);
 }

@@ -539,7 +539,7 @@ class SceneReader {
   void read_simulation(const Table& t) {
     t.only({"name", "dimension", "plane", "thickness", "end_time", "cfl", "dt", "scheme", "flip",
             "precision", "default_law", "force", "sort_every", "fuse_constitutive",
-            "compensated_positions", "mm_fields_share"});
+            "compensated_positions", "fuse_step_tail", "mm_fields_share"});
     SimulationSpec& sim = scene_.simulation;
     const Field d = t.need("dimension");
     const long long dimension = d.integer();
@@ -576,6 +576,7 @@ class SceneReader {
     if (auto f = t.get("sort_every")) sim.sort_every = f->int_at_least(0);
     if (auto f = t.get("fuse_constitutive")) sim.fuse_constitutive = f->boolean();
     if (auto f = t.get("compensated_positions")) sim.compensated_positions = f->boolean();
+    if (auto f = t.get("fuse_step_tail")) sim.fuse_step_tail = f->boolean();
     if (auto f = t.get("mm_fields_share")) {
       sim.mm_fields_share = f->number();
       if (sim.mm_fields_share < 0 || sim.mm_fields_share > 1)

@@ -59,6 +59,11 @@ struct SimulationSpec {
   // is not lost. false: plain float sums, 3-7 % faster steps whose static
   // displacements stop short (docs/performance.md "Positions in float").
   bool compensated_positions = true;
+  // MUSL: the gradient G2P, the constitutive update and the next step's
+  // P2G run tile by tile in one pass, so P2G reads particle columns still
+  // in the cache; same particle results, bitwise (docs/performance.md
+  // "The step's tail fused tile by tile"). false: three separate passes.
+  bool fuse_step_tail = true;
   // The multimaterial fields (mx, Omega, g) are scattered apart, only from
   // tiles that reach a multimaterial node, unless more than this share of
   // the particles sits in such tiles (then with the first P2G). The values

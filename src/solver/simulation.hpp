@@ -38,6 +38,9 @@ struct StepCounters {
   // The last step scattered mx, Omega, g with its first P2G (else apart,
   // from the tiles reaching a multimaterial node; [simulation] mm_fields_share).
   bool mm_fields_with_p2g = false;
+  // Steps of this process whose P2G the previous step's fused tail had
+  // already done ([simulation] fuse_step_tail).
+  long p2g_from_tail = 0;
 };
 
 struct Reaction {

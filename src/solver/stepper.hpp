@@ -54,6 +54,7 @@ class Stepper final : public Simulation {
   StepCounters counters() const override {
     StepCounters c = mm_.counters();
     c.mm_fields_with_p2g = mm_fields_scattered_with_p2g_;
+    c.p2g_from_tail = p2g_from_tail_;
     return c;
   }
   std::vector<Reaction> reactions() const override;
@@ -108,6 +109,18 @@ class Stepper final : public Simulation {
   G2PRangeResult g2p_range_of(const G2PParams& q, std::size_t begin, std::size_t end) const;
   void collect(const std::vector<G2PRangeResult>& results);
   void constitutive();
+  // The constitutive update of particles [lo, hi); returns the first
+  // unsound particle there, or SIZE_MAX.
+  std::size_t constitutive_range(std::size_t lo, std::size_t hi);
+  P2GOptions p2g_options() const;
+  // The step's first P2G (What) of particles [b, e) with the scene's
+  // template flags; p2g_range's contract.
+  template <unsigned What>
+  std::size_t p2g_tile(const P2GOptions& opt, std::size_t b, std::size_t e);
+  // MUSL's last particle stages and the next step's P2G, tile by tile.
+  bool step_tail_fusable() const;
+  void fused_step_tail();
+  double grid_kinetic_energy() const;
   // The velocity-gradient G2P (What adds to kVelocityGradient) and the
   // constitutive update: fused into one pass, or two passes and two stages.
   template <unsigned What>
@@ -164,6 +177,11 @@ class Stepper final : public Simulation {
   bool mm_fields_with_p2g_ = false;
   bool mm_fields_scattered_with_p2g_ = false;  // what the last step did
   bool dirty_ = true;
+  // m, p, f hold the next step's P2G (fused_step_tail); grid_ke_: the grid
+  // kinetic energy computed before that P2G overwrote m.
+  bool grid_ready_ = false;
+  double grid_ke_ = 0;
+  long p2g_from_tail_ = 0;
 
   // Per-material particle lists (several materials, constitutive pass unfused).
   std::vector<std::vector<std::uint32_t>> material_particles_;

@@ -214,6 +214,102 @@ void Stepper<D, Shape, Real>::sort_particles() {
   permute_in_place(P_.key, scratch_keys_.data(), perm_.data(), n);
   rebuild_ranges();
   dirty_ = false;
+  grid_ready_ = false;  // a P2G in the old order
+}
+
+// The tail can take the next step's P2G when nothing changes what that P2G
+// reads before the next step begins: MUSL (the other schemes' last pass
+// sums the external work in chunk order), the constitutive update in its
+// own pass, and the tractions no longer ramping at the next step
+// (update_tractions would rewrite fext).
+template <int D, class Shape, class Real>
+bool Stepper<D, Shape, Real>::step_tail_fusable() const {
+  if (!scene_.simulation.fuse_step_tail || fuse_constitutive_) return false;
+  if (scene_.simulation.scheme != Scheme::MUSL) return false;
+  const double next_time = time_ + dt_;
+  return !has_traction_ || next_time > traction_ramp_end_ + dt_;
+}
+
+// MUSL's last particle stages and the next step's P2G in one pass, tile by
+// tile, color by color (docs/performance.md "The step's tail fused tile by
+// tile"): the gradient G2P of a tile (L, x <- x_next), its constitutive
+// update, then its P2G of m, m v, V sigma into the zeroed m, p, f, which
+// no stage reads after the velocity pass (G2P reads vel and dvel). P2G then
+// reads particle columns the tile's two stages have just touched, instead
+// of fetching them from memory a pass later. Each node receives its sums in
+// the colored P2G's order, so the next step sees bitwise the grid its own
+// P2G would have made. A tile with a particle that changed tile skips its
+// P2G (the particle may reach past the tile's reach) and the next step,
+// which re-sorts, scatters again. The wall time is shared among the g2p,
+// constitutive and p2g stages in the proportions thread 0 measured.
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::fused_step_tail() {
+  using Sec = std::chrono::duration<double>;
+  const auto start = Clock::now();
+  grid_ke_ = grid_kinetic_energy();  // energies(): m is about to be overwritten
+  const bool mm = plan_.multimaterial;
+  zero_grid(mm);
+  const G2PParams q = g2p_params();
+  const P2GOptions opt = p2g_options();
+  const bool with_mm = mm && mm_fields_with_p2g_;  // what the next step's P2G scatters
+  std::vector<G2PRangeResult> res(tiles_.tile_count);
+  std::size_t bad = SIZE_MAX, unsound = SIZE_MAX;
+  double part[3] = {0, 0, 0};  // thread 0: gradient G2P, constitutive, P2G
+  for (std::size_t c = 0; c < schedule_.tiles.size(); ++c) {
+    if (schedule_.tiles[c].empty()) continue;
+#pragma omp parallel reduction(min : bad, unsound) if (P_.n >= kParallelMin)
+    {
+      double mine[3] = {0, 0, 0};
+      for (auto [k, last] = color_share(c); k < last; ++k) {
+        const std::uint32_t t = schedule_.tiles[c][k];
+        const std::size_t b = schedule_.begin[t], e = schedule_.begin[t + 1];
+        const auto t0 = Clock::now();
+        res[t] = g2p_range_of<kCommitPosition | kVelocityGradient>(q, b, e);
+        const auto t1 = Clock::now();
+        unsound = std::min(unsound, constitutive_range(b, e));
+        const auto t2 = Clock::now();
+        if (!res[t].moved_tile) {
+          const std::size_t r = with_mm
+                                    ? p2g_tile<kMassMomentum | kForce | kMultimaterial>(opt, b, e)
+                                    : p2g_tile<kMassMomentum | kForce>(opt, b, e);
+          if (r != e) bad = std::min(bad, r);
+        }
+        const auto t3 = Clock::now();
+        mine[0] += Sec(t1 - t0).count();
+        mine[1] += Sec(t2 - t1).count();
+        mine[2] += Sec(t3 - t2).count();
+      }
+      if (omp_get_thread_num() == 0)
+        for (int i = 0; i < 3; ++i) part[i] += mine[i];
+    }
+  }
+  const double wall = Sec(Clock::now() - start).count();
+  const double measured = part[0] + part[1] + part[2];
+  const Stage stage[3] = {kStageG2P, kStageConstitutive, kStageP2G};
+  for (int i = 0; i < 3; ++i) {
+    stage_s_[stage[i]] += measured > 0 ? wall * part[i] / measured : (i == 0 ? wall : 0.0);
+    ++stage_calls_[stage[i]];
+  }
+  collect(res);  // G2P failures first, as the separate passes report them
+  if (unsound != SIZE_MAX)
+    fail_particle("constitutive", unsound, "J <= 0 or a non-finite stress/volume");
+  if (bad != SIZE_MAX) fail_particle("p2g", bad, "its shape-function stencil left the grid");
+  grid_ready_ = !dirty_;  // a tile change skipped P2Gs; the next step re-sorts
+}
+
+// Kinetic energy of the grid velocity field (after the last update).
+template <int D, class Shape, class Real>
+double Stepper<D, Shape, Real>::grid_kinetic_energy() const {
+  const std::size_t total = G_.nodes * std::size_t(G_.fields);
+  return deterministic_sum<1>(total,
+                              [&](std::size_t b, std::size_t end, std::array<double, 1>& acc) {
+                                for (std::size_t i = b; i < end; ++i) {
+                                  double v2 = 0;
+                                  for (int d = 0; d < D; ++d)
+                                    v2 += double(GV_.vel[d][i]) * double(GV_.vel[d][i]);
+                                  acc[0] += 0.5 * double(G_.m[i]) * v2;
+                                }
+                              })[0];
 }
 
 // Tile ranges, color lists and per-material lists from the (sorted) keys.
@@ -267,11 +363,32 @@ void Stepper<D, Shape, Real>::zero_grid(bool mm) {
 }
 
 template <int D, class Shape, class Real>
-template <unsigned What>
-void Stepper<D, Shape, Real>::p2g(const char* label) {
+P2GOptions Stepper<D, Shape, Real>::p2g_options() const {
   P2GOptions opt;
   opt.position_separation = plan_.position_separation;
   opt.inv_thickness = 1.0 / double(thickness_);
+  return opt;
+}
+
+template <int D, class Shape, class Real>
+template <unsigned What>
+std::size_t Stepper<D, Shape, Real>::p2g_tile(const P2GOptions& opt, std::size_t b, std::size_t e) {
+  if (plan_.multimaterial && domain_gradient_) {
+    constexpr unsigned W = What | ((What & kMultimaterial) ? unsigned(kDomainGradient) : 0u);
+    return has_traction_ ? p2g_range<D, Shape, Real, W, true, true>(P_, G_, opt, b, e)
+                         : p2g_range<D, Shape, Real, W, true, false>(P_, G_, opt, b, e);
+  }
+  if (plan_.multimaterial)
+    return has_traction_ ? p2g_range<D, Shape, Real, What, true, true>(P_, G_, opt, b, e)
+                         : p2g_range<D, Shape, Real, What, true, false>(P_, G_, opt, b, e);
+  return has_traction_ ? p2g_range<D, Shape, Real, What, false, true>(P_, G_, opt, b, e)
+                       : p2g_range<D, Shape, Real, What, false, false>(P_, G_, opt, b, e);
+}
+
+template <int D, class Shape, class Real>
+template <unsigned What>
+void Stepper<D, Shape, Real>::p2g(const char* label) {
+  const P2GOptions opt = p2g_options();
   std::size_t bad = SIZE_MAX;
   for (std::size_t c = 0; c < schedule_.tiles.size(); ++c) {
     if (schedule_.tiles[c].empty()) continue;
@@ -279,17 +396,7 @@ void Stepper<D, Shape, Real>::p2g(const char* label) {
     for (auto [k, last] = color_share(c); k < last; ++k) {
       const std::uint32_t t = schedule_.tiles[c][k];
       const std::size_t b = schedule_.begin[t], e = schedule_.begin[t + 1];
-      std::size_t r;
-      if (plan_.multimaterial && domain_gradient_) {
-        constexpr unsigned W = What | ((What & kMultimaterial) ? unsigned(kDomainGradient) : 0u);
-        r = has_traction_ ? p2g_range<D, Shape, Real, W, true, true>(P_, G_, opt, b, e)
-                          : p2g_range<D, Shape, Real, W, true, false>(P_, G_, opt, b, e);
-      } else if (plan_.multimaterial)
-        r = has_traction_ ? p2g_range<D, Shape, Real, What, true, true>(P_, G_, opt, b, e)
-                          : p2g_range<D, Shape, Real, What, true, false>(P_, G_, opt, b, e);
-      else
-        r = has_traction_ ? p2g_range<D, Shape, Real, What, false, true>(P_, G_, opt, b, e)
-                          : p2g_range<D, Shape, Real, What, false, false>(P_, G_, opt, b, e);
+      const std::size_t r = p2g_tile<What>(opt, b, e);
       if (r != e) bad = std::min(bad, r);
     }
   }
@@ -312,9 +419,7 @@ void Stepper<D, Shape, Real>::p2g_multimaterial() {
   mm_fields_scattered_with_p2g_ = scattered;
   mm_fields_with_p2g_ = double(reaching) > scene_.simulation.mm_fields_share * double(P_.n);
   if (scattered) return;
-  P2GOptions opt;
-  opt.position_separation = plan_.position_separation;
-  opt.inv_thickness = 1.0 / double(thickness_);
+  const P2GOptions opt = p2g_options();
   const std::size_t bad = p2g_multimaterial_fields<D, Shape, Real>(
       P_, G_, opt, tiles_, schedule_, reach_tiles_, domain_gradient_, P_.n >= kParallelMin);
   if (bad != SIZE_MAX) fail_particle("p2g", bad, "its shape-function stencil left the grid");
@@ -418,34 +523,39 @@ void Stepper<D, Shape, Real>::constitutive() {
   {
     const auto [lo, hi] =
         thread_block(n, std::size_t(omp_get_num_threads()), std::size_t(omp_get_thread_num()));
-    if (isotropic_by_material_) isotropic_table_.range(P_, lo, hi);
-    for (std::size_t mi = 0; mi < materials_.size() && !isotropic_by_material_; ++mi) {
-      const MaterialModel& mat = materials_[mi];
-      const std::uint32_t* idx = nullptr;
-      std::size_t first = lo, last = hi;
-      if (!material_particles_.empty()) {
-        const auto& list = material_particles_[mi];
-        idx = list.data();
-        first = std::size_t(std::lower_bound(list.begin(), list.end(), lo) - list.begin());
-        last = std::size_t(std::lower_bound(list.begin(), list.end(), hi) - list.begin());
-      }
-      switch (mat.type) {
-        case MaterialType::isotropic:
-          update_particles(P_, idx, first, last, IsotropicPoint<D, Real>(mat.k, dt_));
-          break;
-        case MaterialType::transverse:
-          update_particles(P_, idx, first, last, AnisotropicPoint<D, Real>(mat.k, dt_));
-          break;
-        case MaterialType::neohookean:
-          update_particles(P_, idx, first, last, NeoHookeanPoint<D, Real>(mat.k, dt_));
-          break;
-        case MaterialType::rigid:
-          break;
-      }
-    }
-    bad = std::min(bad, first_unsound(P_, lo, hi));
+    bad = std::min(bad, constitutive_range(lo, hi));
   }
   if (bad != SIZE_MAX) fail_particle("constitutive", bad, "J <= 0 or a non-finite stress/volume");
+}
+
+template <int D, class Shape, class Real>
+std::size_t Stepper<D, Shape, Real>::constitutive_range(std::size_t lo, std::size_t hi) {
+  if (isotropic_by_material_) isotropic_table_.range(P_, lo, hi);
+  for (std::size_t mi = 0; mi < materials_.size() && !isotropic_by_material_; ++mi) {
+    const MaterialModel& mat = materials_[mi];
+    const std::uint32_t* idx = nullptr;
+    std::size_t first = lo, last = hi;
+    if (!material_particles_.empty()) {
+      const auto& list = material_particles_[mi];
+      idx = list.data();
+      first = std::size_t(std::lower_bound(list.begin(), list.end(), lo) - list.begin());
+      last = std::size_t(std::lower_bound(list.begin(), list.end(), hi) - list.begin());
+    }
+    switch (mat.type) {
+      case MaterialType::isotropic:
+        update_particles(P_, idx, first, last, IsotropicPoint<D, Real>(mat.k, dt_));
+        break;
+      case MaterialType::transverse:
+        update_particles(P_, idx, first, last, AnisotropicPoint<D, Real>(mat.k, dt_));
+        break;
+      case MaterialType::neohookean:
+        update_particles(P_, idx, first, last, NeoHookeanPoint<D, Real>(mat.k, dt_));
+        break;
+      case MaterialType::rigid:
+        break;
+    }
+  }
+  return first_unsound(P_, lo, hi);
 }
 
 template <int D, class Shape, class Real>
@@ -583,27 +693,34 @@ void Stepper<D, Shape, Real>::step() {
   }
   tic();
   const int every = scene_.simulation.sort_every;
-  if (dirty_ || (every > 0 && step_ % every == 0)) sort_particles();
+  if (dirty_ || (every > 0 && step_ % every == 0)) sort_particles();  // clears grid_ready_
   update_node_ownership(false);
   update_tractions();
   toc(kStageSort);
 
-  tic();
-  zero_grid(mm);
-  // mx, Omega, g with this P2G only when p2g_multimaterial chose so.
-  const bool with_mm = mm && mm_fields_with_p2g_;
-  if (scheme == Scheme::USF) {
-    if (with_mm)
-      p2g<kMassMomentum | kMultimaterial>("p2g");
-    else
-      p2g<kMassMomentum>("p2g");
+  // The last step's fused tail has done this P2G already, unless the
+  // particles were re-sorted since (fused_step_tail; it timed its P2G).
+  if (grid_ready_) {
+    grid_ready_ = false;
+    ++p2g_from_tail_;
   } else {
-    if (with_mm)
-      p2g<kMassMomentum | kForce | kMultimaterial>("p2g");
-    else
-      p2g<kMassMomentum | kForce>("p2g");
+    tic();
+    zero_grid(mm);
+    // mx, Omega, g with this P2G only when p2g_multimaterial chose so.
+    const bool with_mm = mm && mm_fields_with_p2g_;
+    if (scheme == Scheme::USF) {
+      if (with_mm)
+        p2g<kMassMomentum | kMultimaterial>("p2g");
+      else
+        p2g<kMassMomentum>("p2g");
+    } else {
+      if (with_mm)
+        p2g<kMassMomentum | kForce | kMultimaterial>("p2g");
+      else
+        p2g<kMassMomentum | kForce>("p2g");
+    }
+    toc(kStageP2G);
   }
-  toc(kStageP2G);
 
   if (mm) {
     tic();
@@ -671,7 +788,10 @@ void Stepper<D, Shape, Real>::step() {
     tic();
     finish_velocities(false);
     toc(kStageGrid);
-    gradient_and_stress<kCommitPosition>();
+    if (step_tail_fusable())
+      fused_step_tail();
+    else
+      gradient_and_stress<kCommitPosition>();
     for (int d = 0; d < D; ++d) P_.x_next[d] = nullptr;
   }
   time_ += dt_;
@@ -732,17 +852,9 @@ Energies Stepper<D, Shape, Real>::energies() const {
   e.interface = mm_.interface_energy();
   e.external_work = external_work_;
   e.damping = damping_loss_;
-  // Kinetic energy of the grid velocity field (after the last update).
-  const std::size_t total = G_.nodes * std::size_t(G_.fields);
-  auto grid_ke =
-      deterministic_sum<1>(total, [&](std::size_t b, std::size_t end, std::array<double, 1>& acc) {
-        for (std::size_t i = b; i < end; ++i) {
-          double v2 = 0;
-          for (int d = 0; d < D; ++d) v2 += double(GV_.vel[d][i]) * double(GV_.vel[d][i]);
-          acc[0] += 0.5 * double(G_.m[i]) * v2;
-        }
-      });
-  e.kinetic_unresolved = step_ > 0 ? e.kinetic - grid_ke[0] : 0.0;
+  // m holds the next step's P2G after a fused tail, which kept the sum.
+  const double grid_ke = grid_ready_ ? grid_ke_ : grid_kinetic_energy();
+  e.kinetic_unresolved = step_ > 0 ? e.kinetic - grid_ke : 0.0;
   return e;
 }
 
@@ -859,6 +971,7 @@ void Stepper<D, Shape, Real>::set_particle_field(const std::string& name,
     throw std::invalid_argument("set_particle_field: only 'velocity' with D values per particle");
   for (std::size_t p = 0; p < P_.n; ++p)
     for (int d = 0; d < D; ++d) P_.v[d][p] = Real(values[p * D + std::size_t(d)]);
+  grid_ready_ = false;  // a fused tail scattered the old momenta
 }
 
 template <int D, class Shape, class Real>
@@ -917,6 +1030,7 @@ void Stepper<D, Shape, Real>::load_state(const std::vector<io::Blob>& blobs) {
   external_work_ = io::read_scalar_blob<double>(io::find_blob(blobs, "external_work"));
   damping_loss_ = io::read_scalar_blob<double>(io::find_blob(blobs, "damping_loss"));
   dirty_ = io::read_scalar_blob<int>(io::find_blob(blobs, "dirty")) != 0;
+  grid_ready_ = false;  // the grid is not in the checkpoint: the next step scatters it again
   mm_.set_interface_energy(io::read_scalar_blob<double>(io::find_blob(blobs, "interface_energy")));
   rebuild_ranges();
 }

@@ -1,0 +1,75 @@
+// Two settings of one scene compared in pairs of adjacent blocks.
+//
+// Why: the step/... rows of a scene with and without a setting run seconds
+// apart, and on this shared host a whole step moves by 10-50 % between such
+// runs (fast and slow spells of minutes), more than most settings change.
+// Here one benchmark holds two Simulations of the scene, A with the
+// solver's defaults and B with one override, and alternates blocks of
+// kSteps steps of each in the order A,B / B,A / ... on the same thread
+// count. Each pair of adjacent blocks gives one ratio t(B) / t(A) per stage
+// and for the whole step, so both sides see the same minutes. One untimed
+// step opens each block: the other Simulation has just pushed this one's
+// grid and particles out of the caches, which a run of one Simulation
+// never does to its first timed step.
+//
+// Counters, per stage s (sort, p2g, mm, grid, g2p, constitutive) and the
+// whole step (s = step):
+//   b_over_a_<s>      median over the pairs of t(B) / t(A): > 1, A faster
+//   b_over_a_<s>_min  min over B blocks / min over A blocks
+//   nsA_<s>, nsB_<s>  the minima, ns per particle per step
+// and pairs. The iteration time (manual) is the two blocks of a pair.
+#include <vector>
+
+#include "bench/bench_common.hpp"
+#include "solver/simulation.hpp"
+
+namespace mmpm::bench {
+namespace {
+
+constexpr int kSteps = 4;  // timed steps per block
+
+void bm_step_ab(benchmark::State& state, const std::string& scene, const std::string& override_b,
+                int threads) {
+  use_threads(threads);
+  try {
+    Simulation& a = step_scene_simulation(scene);
+    Simulation& b = step_scene_simulation(scene, {override_b});
+    for (int k = 0; k < 3; ++k) a.step(), b.step();  // first sort, first touch
+    std::vector<BlockTimes> ta, tb;
+    for (auto _ : state) {
+      const bool a_first = ta.size() % 2 == 0;
+      // Its untimed step: the caches after the other Simulation's block.
+      const BlockTimes first = time_block(a_first ? a : b, kSteps);
+      const BlockTimes second = time_block(a_first ? b : a, kSteps);
+      ta.push_back(a_first ? first : second);
+      tb.push_back(a_first ? second : first);
+      benchmark::ClobberMemory();
+      state.SetIterationTime(first[kStageCount] + second[kStageCount]);
+    }
+    const double per = 1e9 / (kSteps * double(a.particle_count()));
+    set_paired_counters(state, tb, ta, per, "nsB_", "nsA_", "b_over_a_");
+    state.counters["pairs"] = double(ta.size());
+    state.counters["particles"] = double(a.particle_count());
+    state.counters["threads"] = threads;
+  } catch (const std::exception& e) {
+    state.SkipWithError(e.what());
+  }
+}
+
+}  // namespace
+
+void register_step_ab() {
+  // B: MUSL's step tail as three separate passes (A: fused, the default).
+  const std::string tail = "simulation.fuse_step_tail=false";
+  for (const char* scene :
+       {"2d_linear_1mat", "2d_gimp_interface", "2d_gimp_inclusions", "3d_gimp_1mat"})
+    for (int threads : {1, 2}) {
+      const std::string name = std::string("step_ab/scene:") + scene +
+                               "/b:fuse_step_tail_false/threads:" + std::to_string(threads);
+      auto* bm = benchmark::RegisterBenchmark(
+          name.c_str(), [=](benchmark::State& st) { bm_step_ab(st, scene, tail, threads); });
+      configure(bm->UseManualTime()->Unit(benchmark::kMillisecond), 3.0);
+    }
+}
+
+}  // namespace mmpm::bench
