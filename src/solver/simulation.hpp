@@ -76,11 +76,12 @@ class Simulation {
   virtual StepCounters counters() const = 0;
   virtual std::vector<Reaction> reactions() const = 0;  // from the last step
   // Particle quantities by name: position, displacement, velocity, stress,
-  // material, mass, volume, body (components per particle, particle-major).
+  // material, mass, volume, body (components per particle, particle-major,
+  // particles in seed order: a particle keeps its row for the whole run).
   virtual io::ParticleField particle_field(const std::string& name) const = 0;
   virtual io::Snapshot snapshot(const std::vector<std::string>& fields) const = 0;
-  // Sets a per-particle quantity (velocity: D values per particle, in the
-  // current particle order) — for initial conditions the scene keys cannot express.
+  // Sets a per-particle quantity (velocity: D values per particle, in seed
+  // order as particle_field) — for initial conditions the scene keys cannot express.
   virtual void set_particle_field(const std::string& name, const std::vector<double>& values) = 0;
   virtual std::array<double, kStageCount> stage_seconds() const = 0;
   virtual std::array<long, kStageCount> stage_calls() const = 0;

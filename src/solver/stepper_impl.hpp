@@ -120,6 +120,9 @@ void Stepper<D, Shape, Real>::setup_particles(const ParticleSeeds& seeds) {
       P_.xlo[d] = pcols_.add_real(std::string("xlo") + axis[d], n);
       std::fill(P_.xlo[d], P_.xlo[d] + n, Real(0));
     }
+  // Last, so every other column keeps its allocation slot.
+  pcols_.id.allocate(n, pcols_.next_slot++);
+  std::iota(pcols_.id.data(), pcols_.id.data() + n, std::uint32_t(0));
 
   double min_mass = std::numeric_limits<double>::max();
   for (std::size_t p = 0; p < n; ++p) {
@@ -212,6 +215,7 @@ void Stepper<D, Shape, Real>::sort_particles() {
     permute_in_place(col.data(), scratch_bytes_.data(), perm_.data(), n);
   scratch_keys_.resize(n);
   permute_in_place(P_.key, scratch_keys_.data(), perm_.data(), n);
+  permute_in_place(pcols_.id.data(), scratch_keys_.data(), perm_.data(), n);
   rebuild_ranges();
   dirty_ = false;
   grid_ready_ = false;  // a P2G in the old order
@@ -802,7 +806,9 @@ template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::fail_particle(const char* stage, std::size_t p,
                                             const std::string& why) const {
   std::ostringstream os;
-  os << "unstable: stage " << stage << ", step " << step_ << ", particle " << p << " (material '"
+  // The seed index: the particle's row in the outputs (p is where the sorts put it).
+  os << "unstable: stage " << stage << ", step " << step_ << ", particle " << pcols_.id[p]
+     << " (material '"
      << materials_[P_.mat[p]].name << "', x = [";
   for (int d = 0; d < D; ++d) os << (d ? ", " : "") << double(P_.x[d][p]);
   os << "]): " << why;
@@ -874,6 +880,9 @@ std::vector<Reaction> Stepper<D, Shape, Real>::reactions() const {
 template <int D, class Shape, class Real>
 io::ParticleField Stepper<D, Shape, Real>::particle_field(const std::string& name) const {
   const std::size_t n = P_.n;
+  // Rows in seed order (id), so a particle keeps its row from snapshot to
+  // snapshot whatever order the sorts leave the columns in.
+  const std::uint32_t* row = pcols_.id.data();
   io::ParticleField out{name, 1, {}};
   // plus: xlo, the part of the position x does not hold (float only).
   auto vec = [&](const std::array<Real*, D>& a, const std::array<Real*, D>* minus,
@@ -886,7 +895,7 @@ io::ParticleField Stepper<D, Shape, Real>::particle_field(const std::string& nam
         double value = double(a[d][p]);
         if (minus) value -= double((*minus)[d][p]);
         if (plus[0]) value += double(plus[d][p]);
-        out.values[p * D + std::size_t(d)] = value;
+        out.values[row[p] * D + std::size_t(d)] = value;
       }
   };
   if (name == "position") {
@@ -899,7 +908,7 @@ io::ParticleField Stepper<D, Shape, Real>::particle_field(const std::string& nam
     out.components = NS;
     out.values.resize(n * NS);
     for (std::size_t p = 0; p < n; ++p)
-      for (int c = 0; c < NS; ++c) out.values[p * NS + std::size_t(c)] = double(P_.s[c][p]);
+      for (int c = 0; c < NS; ++c) out.values[row[p] * NS + std::size_t(c)] = double(P_.s[c][p]);
   } else if (name == "strain") {
     // Small-strain materials: eps = S sigma (tensor components, as the
     // stress); finite-strain ones: Green-Lagrange E = (F^T F - I) / 2.
@@ -930,7 +939,7 @@ io::ParticleField Stepper<D, Shape, Real>::particle_field(const std::string& nam
           if (i >= 3) e[i] *= 0.5;
         }
       }
-      double* o = &out.values[p * NS];
+      double* o = &out.values[row[p] * NS];
       if constexpr (D == 2) {
         o[0] = e[0], o[1] = e[1], o[2] = e[5], o[3] = e[2];
       } else {
@@ -945,16 +954,16 @@ io::ParticleField Stepper<D, Shape, Real>::particle_field(const std::string& nam
     out.values.resize(n * D * D);
     for (std::size_t p = 0; p < n; ++p)
       for (int c = 0; c < D * D; ++c)
-        out.values[p * D * D + std::size_t(c)] =
+        out.values[row[p] * D * D + std::size_t(c)] =
             double(P_.H[c][p]) + ((c % (D + 1)) == 0 ? 1.0 : 0.0);  // F = I + H
   } else if (name == "body") {
     out.values.resize(n);
     const std::uint8_t* body = pcols_.byte("body");
-    for (std::size_t p = 0; p < n; ++p) out.values[p] = double(body[p]);
+    for (std::size_t p = 0; p < n; ++p) out.values[row[p]] = double(body[p]);
   } else if (name == "material" || name == "mass" || name == "volume") {
     out.values.resize(n);
     for (std::size_t p = 0; p < n; ++p)
-      out.values[p] = name == "material" ? double(P_.mat[p])
+      out.values[row[p]] = name == "material" ? double(P_.mat[p])
                                          : (name == "mass" ? double(P_.m[p]) : double(P_.V[p]));
   } else {
     throw InputError("output field '" + name +
@@ -969,8 +978,9 @@ void Stepper<D, Shape, Real>::set_particle_field(const std::string& name,
                                                  const std::vector<double>& values) {
   if (name != "velocity" || values.size() != P_.n * D)
     throw std::invalid_argument("set_particle_field: only 'velocity' with D values per particle");
+  const std::uint32_t* row = pcols_.id.data();  // values in seed order, as particle_field
   for (std::size_t p = 0; p < P_.n; ++p)
-    for (int d = 0; d < D; ++d) P_.v[d][p] = Real(values[p * D + std::size_t(d)]);
+    for (int d = 0; d < D; ++d) P_.v[d][p] = Real(values[row[p] * D + std::size_t(d)]);
   grid_ready_ = false;  // a fused tail scattered the old momenta
 }
 
@@ -1000,6 +1010,7 @@ std::vector<io::Blob> Stepper<D, Shape, Real>::save_state() const {
         "b." + pcols_.byte_names[c],
         std::vector<std::uint8_t>(pcols_.bytes[c].data(), pcols_.bytes[c].data() + n)));
   out.push_back(io::make_blob("key", std::vector<std::uint32_t>(P_.key, P_.key + n)));
+  out.push_back(io::make_blob("id", std::vector<std::uint32_t>(pcols_.id.data(), pcols_.id.data() + n)));
   out.push_back(io::make_scalar_blob("step", step_));
   out.push_back(io::make_scalar_blob("time", time_));
   out.push_back(io::make_scalar_blob("external_work", external_work_));
@@ -1025,6 +1036,7 @@ void Stepper<D, Shape, Real>::load_state(const std::vector<io::Blob>& blobs) {
   for (std::size_t c = 0; c < pcols_.bytes.size(); ++c)
     load_column("b." + pcols_.byte_names[c], const_cast<std::uint8_t*>(pcols_.bytes[c].data()));
   load_column("key", P_.key);
+  load_column("id", pcols_.id.data());
   step_ = io::read_scalar_blob<long>(io::find_blob(blobs, "step"));
   time_ = io::read_scalar_blob<double>(io::find_blob(blobs, "time"));
   external_work_ = io::read_scalar_blob<double>(io::find_blob(blobs, "external_work"));

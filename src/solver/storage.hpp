@@ -18,6 +18,9 @@ struct ColumnSet {
   std::vector<std::string> byte_names;
   std::vector<StaggeredArray<std::uint8_t>> bytes;
   StaggeredArray<std::uint32_t> key;  // binning key (particles only)
+  // Seed index (particles only): the particle's row in every output and its
+  // number in messages, whatever order the sorts left it in.
+  StaggeredArray<std::uint32_t> id;
   int next_slot = 0;
 
   Real* add_real(const std::string& name, std::size_t n) {
