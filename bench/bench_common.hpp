@@ -183,6 +183,7 @@ struct ParticleSet {
   std::vector<StaggeredArray<Real>> reals;  // every real column, permuted together
   std::vector<StaggeredArray<std::uint8_t>> bytes;
   StaggeredArray<std::uint32_t> key;
+  StaggeredArray<std::uint32_t> id;  // seed index (the Stepper's tie-break in the sort)
   ParticleView<D, Real> P;
   int slot = 0;
 
@@ -203,7 +204,7 @@ struct ParticleSet {
   std::size_t size() const { return P.n; }
   // Bytes a particle occupies over all its columns.
   std::size_t bytes_per_particle() const {
-    return reals.size() * sizeof(Real) + bytes.size() + sizeof(std::uint32_t);
+    return reals.size() * sizeof(Real) + bytes.size() + 2 * sizeof(std::uint32_t);
   }
 };
 
@@ -238,6 +239,8 @@ void make_block(ParticleSet<D, Real>& S, const BlockSpec& b) {
   if (b.multifield) P.field = S.add_byte(n);
   S.key.allocate(n, S.slot++);
   P.key = S.key.data();
+  S.id.allocate(n, S.slot++);
+  for (std::size_t p = 0; p < n; ++p) S.id[p] = std::uint32_t(p);
 
   const double spacing = 1.0 / b.ppc;
   const double vol = std::pow(spacing, D);
@@ -310,8 +313,10 @@ struct GridSet {
 };
 
 // ---------------------------------------------------------------- binning
-// The solver's sort (Stepper::sort_particles + rebuild_ranges): keys by tile,
-// stable counting sort, every column permuted, tile ranges and color lists.
+// The solver's sort (Stepper::sort_particles): keys by tile, stable counting
+// sort (a cell's particles in seed order), the keys permuted, tile ranges
+// and color lists of the new order, then every other column permuted into
+// the threads' ranges of that order.
 template <int D, class Real>
 struct Binning {
   TileLayout<D> tiles;
@@ -337,23 +342,32 @@ struct Binning {
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
     for (std::size_t p = 0; p < n; ++p) S.P.key[p] = key_of(S.P, G, p);
   }
-  void permute(ParticleSet<D, Real>& S) {
-    const std::size_t n = S.P.n;
-    scratch.resize(n);
-    for (auto& col : S.reals) permute_in_place(col.data(), scratch.data(), perm.data(), n);
-    scratch_bytes.resize(n);
-    for (auto& col : S.bytes) permute_in_place(col.data(), scratch_bytes.data(), perm.data(), n);
-    scratch_keys.resize(n);
-    permute_in_place(S.P.key, scratch_keys.data(), perm.data(), n);
+  void count(ParticleSet<D, Real>& S) {
+    counting_sort(S.P.key, S.P.n, tiles.key_count(), offsets, perm, S.id.data());
+  }
+  void permute_keys(ParticleSet<D, Real>& S) {
+    scratch_keys.resize(S.P.n);
+    permute_in_place(S.P.key, scratch_keys.data(), perm.data(), S.P.n);
   }
   void rebuild_ranges(const ParticleSet<D, Real>& S) {
     schedule.build(tiles, S.P.key, S.P.n);
   }
+  void permute_columns(ParticleSet<D, Real>& S) {
+    const std::size_t n = S.P.n;
+    permute_in_place(S.id.data(), scratch_keys.data(), perm.data(), n, &schedule);
+    scratch.resize(n);
+    for (auto& col : S.reals)
+      permute_in_place(col.data(), scratch.data(), perm.data(), n, &schedule);
+    scratch_bytes.resize(n);
+    for (auto& col : S.bytes)
+      permute_in_place(col.data(), scratch_bytes.data(), perm.data(), n, &schedule);
+  }
   void sort(ParticleSet<D, Real>& S, const GridView<D, Real>& G) {
     compute_keys(S, G);
-    counting_sort(S.P.key, S.P.n, tiles.key_count(), offsets, perm);
-    permute(S);
+    count(S);
+    permute_keys(S);
     rebuild_ranges(S);
+    permute_columns(S);
   }
 };
 

@@ -32,9 +32,23 @@ struct TileLayout {
   std::uint32_t keys_per_tile = 1;  // T^D
   int key_shift = 3 * D;            // log2(keys_per_tile)
   std::uint32_t tile_count = 1;
+  // The order tiles are stored in (docs/performance.md "Particles stored
+  // color by color"). A key holds the tile's slot, not its index: with
+  // color_major, the slots run through color 0's tiles (in tile order), then
+  // color 1's, ..., so each colored pass reads its particles front to back;
+  // without, slot = tile index (x fastest). Tile indices (x fastest, like
+  // the nodes) stay what every geometric question is asked in.
+  bool color_major = true;
+  // Per direction, how many tiles have an even (half[0]) and an odd
+  // (half[1]) index: a color's tiles form a half[p_x] x half[p_y] (x
+  // half[p_z]) lattice.
+  std::array<std::array<std::uint32_t, 2>, 3> half{};
+  // First slot of each color (color c = sum of p_d << d, p_d the parity of
+  // the tile's index along d); color_begin[1 << D] = tile_count.
+  std::array<std::uint32_t, 9> color_begin{};
 
   // tile_edge is rounded up to a power of two, at least 4.
-  void setup(int tile_edge, const std::array<int, 3>& grid_cells) {
+  void setup(int tile_edge, const std::array<int, 3>& grid_cells, bool by_color = true) {
     shift = 2;
     while ((1 << shift) < tile_edge) ++shift;
     T = 1 << shift;
@@ -42,12 +56,77 @@ struct TileLayout {
     cells = grid_cells;
     keys_per_tile = 1u << key_shift;
     tile_count = 1;
+    color_major = by_color;
     for (int d = 0; d < D; ++d) {
       tiles[d] = (cells[d] + T - 1) >> shift;
       tile_count *= std::uint32_t(tiles[d]);
+      half[d] = {std::uint32_t(tiles[d] + 1) / 2, std::uint32_t(tiles[d]) / 2};
+    }
+    for (int d = D; d < 3; ++d) half[d] = {1, 0};
+    color_begin.fill(tile_count);
+    std::uint32_t next = 0;
+    for (int c = 0; c < (1 << D); ++c) {
+      color_begin[c] = next;
+      std::uint32_t count = 1;
+      for (int d = 0; d < D; ++d) count *= half[d][(c >> d) & 1];
+      next += count;
     }
   }
   std::uint32_t key_count() const { return tile_count * keys_per_tile; }
+
+  // The slot of the tile at tile coordinates t.
+  std::uint32_t slot(const std::uint32_t (&t)[3]) const {
+    return color_major ? color_major_slot(t, half, tiles)
+                       : tile_index(int(t[0]), int(t[1]), int(t[2]));
+  }
+  // The color-major slot from the layout's numbers passed by value, so that
+  // PositionTile::any_moved can call it on locals inside its vector loop.
+  // Selects only: the rank inside the color's lattice, h_x + half_x (h_y +
+  // half_y h_z) (h = t >> 1), plus the slots of the colors before it, which
+  // order colors by p_z, then p_y, then p_x: sum over k of p_k half_k[0]
+  // prod_{d<k} tiles_d prod_{d>k} half_d[p_d].
+  static std::uint32_t color_major_slot(const std::uint32_t (&t)[3],
+                                        const std::array<std::array<std::uint32_t, 2>, 3>& half,
+                                        const std::array<int, 3>& tiles) {
+    std::uint32_t rank = 0, stride = 1, before = 0, below = 1;
+    std::uint32_t above[3] = {1, 1, 1};  // prod_{d>k} half_d[p_d]
+    for (int d = D - 1; d > 0; --d) above[d - 1] = above[d] * half[d][t[d] & 1];
+    for (int d = 0; d < D; ++d) {
+      const std::uint32_t p = t[d] & 1;
+      rank += (t[d] >> 1) * stride;
+      stride *= p ? half[d][1] : half[d][0];
+      before += p * half[d][0] * below * above[d];
+      below *= std::uint32_t(tiles[d]);
+    }
+    return before + rank;
+  }
+  std::uint32_t slot_of_tile(std::uint32_t tile) const {
+    std::uint32_t t[3] = {0, 0, 0};
+    for (int d = 0; d < D; ++d) {
+      t[d] = tile % std::uint32_t(tiles[d]);
+      tile /= std::uint32_t(tiles[d]);
+    }
+    return slot(t);
+  }
+  int color_of_slot(std::uint32_t s) const {
+    if (!color_major) return color(s);
+    int c = 0;
+    while (c + 1 < (1 << D) && s >= color_begin[c + 1]) ++c;
+    return c;
+  }
+  std::uint32_t tile_of_slot(std::uint32_t s) const {
+    if (!color_major) return s;
+    const int c = color_of_slot(s);
+    std::uint32_t rank = s - color_begin[c], tile = 0, stride = 1;
+    for (int d = 0; d < D; ++d) {
+      const std::uint32_t p = std::uint32_t(c >> d) & 1, n = half[d][p];
+      const std::uint32_t h = d + 1 < D ? rank % n : rank;
+      rank = d + 1 < D ? rank / n : 0;
+      tile += (2 * h + p) * stride;
+      stride *= std::uint32_t(tiles[d]);
+    }
+    return tile;
+  }
 
   // Key of a cell given by its integer indices (clamped into the grid so that
   // a particle exactly on the upper boundary still gets a valid key).
@@ -58,17 +137,17 @@ struct TileLayout {
   // order they would overlap by all but one node, a partial overlap the
   // CPU cannot forward (the load waits for the store to reach the cache).
   std::uint32_t key(const std::array<int, 3>& c_in) const {
-    std::uint32_t tile = 0, local = 0, tstride = 1;
+    std::uint32_t t[3] = {0, 0, 0}, local = 0;
     for (int d = 0; d < D; ++d) {
       const int c = c_in[d] < 0 ? 0 : (c_in[d] >= cells[d] ? cells[d] - 1 : c_in[d]);
-      tile += std::uint32_t(c >> shift) * tstride;
-      const int slot = d == 0 ? D - 1 : d - 1;  // x -> highest bits
-      local |= std::uint32_t(c & (T - 1)) << (slot * shift);
-      tstride *= std::uint32_t(tiles[d]);
+      t[d] = std::uint32_t(c >> shift);
+      const int slot_bits = d == 0 ? D - 1 : d - 1;  // x -> highest bits
+      local |= std::uint32_t(c & (T - 1)) << (slot_bits * shift);
     }
-    return (tile << key_shift) | local;
+    return (slot(t) << key_shift) | local;
   }
-  std::uint32_t tile_of_key(std::uint32_t k) const { return k >> key_shift; }
+  std::uint32_t slot_of_key(std::uint32_t k) const { return k >> key_shift; }
+  std::uint32_t tile_of_key(std::uint32_t k) const { return tile_of_slot(slot_of_key(k)); }
   // Index of the tile at tile coordinates (tx, ty, tz), x fastest.
   std::size_t tile_index(int tx, int ty, int tz) const {
     return std::size_t(tx) +
@@ -86,33 +165,35 @@ struct TileLayout {
 
 // Where the particles of each tile are, and which tiles each thread takes in
 // a colored pass (colors in turn, the tiles of one color in parallel).
+// Tiles are named by their slots (TileLayout): the particles of slot s are
+// [begin[s], begin[s + 1]).
 //
 // Thread i of T takes the tiles holding the i-th T-quantile of the color's
-// particles, in tile order, rather than tiles handed out dynamically.
-// Particles are stored tile by tile, so thread i then works on (nearly) the
-// same particles in every colored pass as in the static particle loops
-// (schedule(static): the i-th contiguous block of particles), and a
-// particle's cache lines stay in one core's caches from pass to pass. A
-// dynamic tile schedule moved them between the cores in every pass: the 2D
-// linear step on 2 threads took 29 ns/particle with it and 20 with this
-// split (docs/performance.md, "Threads keep their particles"). Which thread
-// runs a tile does not change what the tile computes, so the split leaves
-// the results bitwise unchanged.
+// particles, in slot order, rather than tiles handed out dynamically, and
+// every particle loop of the Stepper gives each thread the same particles
+// (thread_ranges), so a particle's cache lines stay in one core's caches
+// from pass to pass. A dynamic tile schedule moved them between the cores
+// in every pass: the 2D linear step on 2 threads took 29 ns/particle with
+// it and 20 with this split (docs/performance.md, "Threads keep their
+// particles"). Which thread runs a tile does not change what the tile
+// computes, so the split leaves the results bitwise unchanged.
 struct TileSchedule {
-  std::vector<std::uint32_t> begin;                  // first particle per tile, size tiles + 1
-  std::array<std::vector<std::uint32_t>, 8> tiles;   // non-empty tiles per color, in order
+  std::vector<std::uint32_t> begin;                  // first particle per slot, size tiles + 1
+  std::array<std::vector<std::uint32_t>, 8> tiles;   // non-empty slots per color, in order
   std::array<std::vector<std::uint32_t>, 8> prefix;  // per color: particles in tiles [0, k)
+  bool color_major = true;                           // the layout's storage order
 
   // From the sorted keys of n particles.
   template <int D>
   void build(const TileLayout<D>& layout, const std::uint32_t* key, std::size_t n) {
     const std::uint32_t nt = layout.tile_count;
+    color_major = layout.color_major;
     begin.assign(std::size_t(nt) + 1, 0);
-    for (std::size_t p = 0; p < n; ++p) ++begin[layout.tile_of_key(key[p]) + 1];
+    for (std::size_t p = 0; p < n; ++p) ++begin[layout.slot_of_key(key[p]) + 1];
     for (std::uint32_t t = 0; t < nt; ++t) begin[t + 1] += begin[t];
     for (auto& c : tiles) c.clear();
     for (std::uint32_t t = 0; t < nt; ++t)
-      if (begin[t + 1] > begin[t]) tiles[std::size_t(layout.color(t))].push_back(t);
+      if (begin[t + 1] > begin[t]) tiles[std::size_t(layout.color_of_slot(t))].push_back(t);
     for (std::size_t c = 0; c < tiles.size(); ++c) {
       prefix[c].assign(tiles[c].size() + 1, 0);
       for (std::size_t k = 0; k < tiles[c].size(); ++k)
@@ -133,6 +214,35 @@ struct TileSchedule {
                          pre.begin());
     };
     return {boundary(i), boundary(i + 1)};
+  }
+
+  // The particles thread i of `threads` takes in the loops that are not
+  // colored, as up to 8 ranges [first, last): stored color by color, its
+  // tiles of each color are one range (the colored passes' share); stored
+  // in tile order, its shares of the colors interleave, and the i-th
+  // contiguous block of the n particles is what they cover, to a tile.
+  struct Ranges {
+    std::array<std::pair<std::size_t, std::size_t>, 8> range{};
+    std::size_t count = 0;
+  };
+  Ranges thread_ranges(std::size_t threads, std::size_t i) const {
+    Ranges r;
+    const std::size_t n = begin.empty() ? 0 : begin.back();
+    if (!color_major || threads < 2) {
+      r.range[0] = thread_block(n, threads, i);
+      r.count = r.range[0].second > r.range[0].first ? 1 : 0;
+      return r;
+    }
+    for (std::size_t c = 0; c < tiles.size(); ++c) {
+      const auto [first, last] = share(c, threads, i);
+      if (first >= last) continue;
+      const std::size_t b = begin[tiles[c][first]], e = begin[tiles[c][last - 1] + 1];
+      if (r.count && r.range[r.count - 1].second == b)
+        r.range[r.count - 1].second = e;  // adjoins the previous color's range
+      else
+        r.range[r.count++] = {b, e};
+    }
+    return r;
   }
 };
 
@@ -160,7 +270,7 @@ struct PositionTile {
   }
   std::uint32_t tile_of_key(std::uint32_t k) const { return tiles.tile_of_key(k); }
   // Whether any particle of [begin, end) is outside the tile of its key: the
-  // test of tile(p) != tile_of_key(key[p]) for a whole range, as one loop the
+  // test of slot(tile(p)) != slot_of_key(key[p]) for a whole range, as one loop the
   // compiler vectorises. Asked per particle inside G2P, this test was a fifth
   // of the instructions of the gradient pass (docs/performance.md). The
   // members are copied to locals first: read through `this` inside the loop,
@@ -168,6 +278,13 @@ struct PositionTile {
   // 2D linear G2P kernel; docs/performance.md "The tile-change test ran
   // scalar").
   bool any_moved(const std::uint32_t* __restrict key, std::size_t begin, std::size_t end) const {
+    return tiles.color_major ? moved_tiles<true>(key, begin, end)
+                             : moved_tiles<false>(key, begin, end);
+  }
+
+ private:
+  template <bool ColorMajor>
+  bool moved_tiles(const std::uint32_t* __restrict key, std::size_t begin, std::size_t end) const {
     const Real* __restrict pos[D];
     Real x0[D], scale[D];
     int last_cell[D];
@@ -180,51 +297,89 @@ struct PositionTile {
       stride[d] = tiles_below;
       tiles_below *= std::uint32_t(tiles.tiles[k]);
     }
+    const auto half = tiles.half;
+    const auto counts = tiles.tiles;
     const int shift = tiles.shift;
     const int key_shift = tiles.key_shift;
     unsigned moved = 0;
 #pragma omp simd reduction(| : moved)
     for (std::size_t p = begin; p < end; ++p) {
-      std::uint32_t t = 0;
+      std::uint32_t t[3] = {0, 0, 0}, slot = 0;
       for (int d = 0; d < D; ++d) {
         const int c = std::clamp(int(std::floor((pos[d][p] - x0[d]) * scale[d])), 0, last_cell[d]);
-        t += std::uint32_t(c >> shift) * stride[d];
+        t[d] = std::uint32_t(c >> shift);
+        if constexpr (!ColorMajor) slot += t[d] * stride[d];
       }
-      moved |= unsigned(t != (key[p] >> key_shift));
+      if constexpr (ColorMajor) slot = TileLayout<D>::color_major_slot(t, half, counts);
+      moved |= unsigned(slot != (key[p] >> key_shift));
     }
     return moved != 0;
   }
 };
 
 // Stable counting sort: fills perm so that perm[new] = old, and offsets
-// (size key_count + 1) with the first sorted position of every key.
+// (size key_count + 1) with the first sorted position of every key. With
+// `tie` (the particles' seed ids), the particles of one key (one cell) are
+// put in tie order instead of their old order: the order a cell's
+// particles add into the grid then depends on which particles the cell
+// holds, not on the order the last sort left them in, so the results do
+// not depend on the storage order (particle_order "color" or "tile"). A
+// cell holds a handful of particles, mostly still in order: an insertion
+// sort per cell.
 inline void counting_sort(const std::uint32_t* key, std::size_t n, std::uint32_t key_count,
-                          std::vector<std::uint32_t>& offsets, std::vector<std::uint32_t>& perm) {
+                          std::vector<std::uint32_t>& offsets, std::vector<std::uint32_t>& perm,
+                          const std::uint32_t* tie = nullptr) {
   offsets.assign(std::size_t(key_count) + 1, 0);
   for (std::size_t p = 0; p < n; ++p) ++offsets[key[p] + 1];
   for (std::size_t k = 0; k < key_count; ++k) offsets[k + 1] += offsets[k];
   perm.resize(n);
   std::vector<std::uint32_t> next(offsets.begin(), offsets.end() - 1);
   for (std::size_t p = 0; p < n; ++p) perm[next[key[p]]++] = std::uint32_t(p);
+  if (!tie) return;
+  // The tie values in sorted position first (one gather), so the sort reads
+  // them in order instead of at random old positions: from a shuffled start
+  // those random reads took longer than the rest of the sort.
+  std::vector<std::uint32_t> t(n);
+  for (std::size_t i = 0; i < n; ++i) t[i] = tie[perm[i]];
+  for (std::size_t k = 0; k < key_count; ++k)
+    for (std::uint32_t i = offsets[k] + 1; i < offsets[k + 1]; ++i) {
+      const std::uint32_t q = perm[i], tq = t[i];
+      std::uint32_t j = i;
+      for (; j > offsets[k] && t[j - 1] > tq; --j) perm[j] = perm[j - 1], t[j] = t[j - 1];
+      perm[j] = q, t[j] = tq;
+    }
 }
 
 // a[i] <- a[perm[i]] for one array, through `scratch` (n entries). Each
-// thread gathers its static block into scratch and, after all have
-// gathered, copies the same block back: the array's block then ends in the
-// cache of the thread whose particle loops use it (schedule(static),
+// thread gathers its particles into scratch and, after all have gathered,
+// copies the same particles back: they then end in the cache of the thread
+// whose particle loops use them (`sorted`: the schedule of the new order,
+// TileSchedule::thread_ranges; without it, the static block;
 // kernels/node_ownership.hpp explains why that matters on this machine).
 // A serial copy-back left half of every column in the other core's cache
 // and made the 2-thread sort slower than the 1-thread one.
 template <class T>
 inline void permute_in_place(T* __restrict a, T* __restrict scratch,
-                             const std::uint32_t* __restrict perm, std::size_t n) {
+                             const std::uint32_t* __restrict perm, std::size_t n,
+                             const TileSchedule* sorted = nullptr) {
 #pragma omp parallel if (n >= kParallelMin)
   {
-    const auto [b, e] =
-        thread_block(n, std::size_t(omp_get_num_threads()), std::size_t(omp_get_thread_num()));
-    for (std::size_t i = b; i < e; ++i) scratch[i] = a[perm[i]];
+    const auto threads = std::size_t(omp_get_num_threads()), me = std::size_t(omp_get_thread_num());
+    TileSchedule::Ranges mine;
+    if (sorted) {
+      mine = sorted->thread_ranges(threads, me);
+    } else {
+      mine.range[0] = thread_block(n, threads, me);
+      mine.count = 1;
+    }
+    for (std::size_t r = 0; r < mine.count; ++r)
+      for (std::size_t i = mine.range[r].first; i < mine.range[r].second; ++i)
+        scratch[i] = a[perm[i]];
 #pragma omp barrier
-    if (e > b) std::memcpy(a + b, scratch + b, (e - b) * sizeof(T));
+    for (std::size_t r = 0; r < mine.count; ++r) {
+      const auto [b, e] = mine.range[r];
+      if (e > b) std::memcpy(a + b, scratch + b, (e - b) * sizeof(T));
+    }
   }
 }
 

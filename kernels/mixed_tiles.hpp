@@ -38,8 +38,8 @@ struct MixedTiles {
   std::vector<std::uint32_t> span_begin;
   std::vector<std::array<std::uint32_t, 2>> spans;
 
-  // From the tile ranges of the sorted particles (TileSchedule::begin) and
-  // their fields.
+  // From the tile ranges of the sorted particles (TileSchedule::begin, by
+  // slot) and their fields.
   void build(const TileLayout<D>& tiles, const std::array<int, 3>& nodes,
              const std::vector<std::uint32_t>& begin, const std::uint8_t* field) {
     layout = tiles;
@@ -49,7 +49,8 @@ struct MixedTiles {
     constexpr int kEmpty = -1, kSeveral = -2;
     std::vector<int> one(nt, kEmpty);
     for (std::size_t t = 0; t < nt; ++t) {
-      for (std::uint32_t p = begin[t]; p < begin[t + 1]; ++p) {
+      const std::uint32_t s = layout.slot_of_tile(std::uint32_t(t));
+      for (std::uint32_t p = begin[s]; p < begin[s + 1]; ++p) {
         const int f = field[p];
         if (one[t] == kEmpty) {
           one[t] = f;

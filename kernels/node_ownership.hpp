@@ -12,11 +12,11 @@
 // old split of the flat (field, node) range gave thread 0 all of field 0
 // and thread 1 all of field 1: every line P2G wrote then crossed.
 //
-// The ownership is a cut of the node index range inside the band of the
-// tile where each thread's particles begin (particles are stored tile by
-// tile, tiles x fastest, like the nodes), so thread i owns, in every field,
-// the nodes of the rows its tiles cover, up to the band the threads share,
-// where the cut balances the node counts. Which thread runs a node never
+// The ownership is a cut of the node index range inside the bands of the
+// tiles where each thread's particles begin (each color's tiles are split
+// among the threads in tile order, x fastest like the nodes), so thread i
+// owns, in every field, the nodes of the rows its tiles cover, up to the
+// bands the threads share, where the cut balances the node counts. Which thread runs a node never
 // changes what the node computes, and the reductions below keep their
 // fixed chunks, so results do not depend on the split or the thread count.
 #pragma once
@@ -61,35 +61,44 @@ struct NodeOwnership {
   }
 };
 
-// The split for `threads` threads from the particles' sorted keys. Thread
-// i's particles start at n i / threads (the static particle loops' block,
-// and within a tile the colored passes' quantile), in some tile. The
-// threads' P2G writes meet inside that tile's band: its tile row (2D) or
-// tile layer (3D), all nodes whose highest coordinate lies in the tile's
-// range. Below the band one thread wrote the nodes, above it the other;
-// inside it they share each row. So any cut inside the band crosses at most
-// one band of written nodes to the other core. The cut is the one nearest
-// the even split nodes i / threads. Why not the tile's lowest node (the
-// cut before): with 8-cell tiles in 3D that left thread 0 ~30 % of the
-// nodes of a block filling its grid, and every node loop waited on the
-// other thread (docs/performance.md "A cut balanced inside the band").
+// The split for `threads` threads from the tile schedule of the sorted
+// particles. In every color, thread i's tiles begin in some tile
+// (TileSchedule::share, the colored passes' split, which the other
+// particle loops follow too). The threads' P2G writes meet inside those
+// tiles' bands: each one's tile row (2D) or tile layer (3D), all nodes
+// whose highest coordinate lies in the tile's range. Below the lowest band
+// one thread wrote the nodes, above the highest the other; inside them
+// they share rows. So a cut inside the bands crosses at most those bands'
+// written nodes to the other core. The cut is the one nearest the even
+// split nodes i / threads. Why not the tile's lowest node (the cut before):
+// with 8-cell tiles in 3D that left thread 0 ~30 % of the nodes of a block
+// filling its grid, and every node loop waited on the other thread
+// (docs/performance.md "A cut balanced inside the band").
 template <int D>
 NodeOwnership node_ownership(const TileLayout<D>& layout, const std::array<int, 3>& nodes_per_dim,
-                             const std::uint32_t* sorted_key, std::size_t n, std::size_t threads) {
+                             const TileSchedule& schedule, std::size_t threads) {
   NodeOwnership own;
   std::size_t nodes = 1;
   for (int d = 0; d < D; ++d) nodes *= std::size_t(nodes_per_dim[std::size_t(d)]);
-  if (threads < 2 || n == 0) return own;
+  if (threads < 2 || schedule.begin.empty() || schedule.begin.back() == 0) return own;
   const std::size_t top_nodes = std::size_t(nodes_per_dim[std::size_t(D - 1)]);
   const std::size_t slice = nodes / top_nodes;  // nodes per row (2D) or layer (3D)
   const std::size_t tiles_below_top =
       std::size_t(layout.tile_count) / std::size_t(layout.tiles[std::size_t(D - 1)]);
   own.split.assign(threads + 1, 0);
   for (std::size_t i = 1; i < threads; ++i) {
-    const std::size_t tile = layout.tile_of_key(sorted_key[n * i / threads]);
-    const std::size_t first = (tile / tiles_below_top) << layout.shift;  // band's lowest slice
+    std::size_t first = top_nodes, last = 0;  // band slices [first, last)
+    for (std::size_t c = 0; c < schedule.tiles.size(); ++c) {
+      const auto& list = schedule.tiles[c];
+      if (list.empty()) continue;
+      const std::size_t k = std::min(schedule.share(c, threads, i).first, list.size() - 1);
+      const std::size_t tile = layout.tile_of_slot(list[k]);
+      const std::size_t low = (tile / tiles_below_top) << layout.shift;  // band's lowest slice
+      first = std::min(first, low);
+      last = std::max(last, low + std::size_t(layout.T));
+    }
     const std::size_t band_lo = std::min(first, top_nodes) * slice;
-    const std::size_t band_hi = std::min(first + std::size_t(layout.T), top_nodes) * slice;
+    const std::size_t band_hi = std::min(last, top_nodes) * slice;
     const std::size_t even = nodes * i / threads;
     own.split[i] = std::clamp(std::clamp(even, band_lo, band_hi), own.split[i - 1], nodes);
   }

@@ -28,8 +28,8 @@ namespace mmpm {
 
 // Scratch of the pass, kept between steps (no allocation once warm).
 struct ReachTiles {
-  std::vector<std::uint8_t> flag;                   // per tile: reaches a listed node
-  std::array<std::vector<std::uint32_t>, 8> tiles;  // those tiles, per color, in order
+  std::vector<std::uint8_t> flag;                   // per tile index: reaches a listed node
+  std::array<std::vector<std::uint32_t>, 8> tiles;  // their slots, per color, in order
 };
 
 // Flags the tiles of `schedule` that reach one of `nodes` (one field's node
@@ -44,8 +44,8 @@ std::size_t find_reach_tiles(const GridView<D, Real>& G, const TileLayout<D>& la
   std::size_t particles = 0;
   for (std::size_t c = 0; c < reach_tiles.tiles.size(); ++c) {
     reach_tiles.tiles[c].clear();
-    for (const std::uint32_t t : schedule.tiles[c])
-      if (reach_tiles.flag[t]) {
+    for (const std::uint32_t t : schedule.tiles[c])  // slots
+      if (reach_tiles.flag[layout.tile_of_slot(t)]) {
         reach_tiles.tiles[c].push_back(t);
         particles += schedule.begin[t + 1] - schedule.begin[t];
       }
@@ -68,7 +68,8 @@ std::size_t p2g_multimaterial_fields(const ParticleView<D, Real>& P, const GridV
   for (const auto& list : reach_tiles.tiles) {
 #pragma omp parallel for schedule(static) if (parallel)
     for (std::size_t k = 0; k < list.size(); ++k) {
-      const NodeBox box = tile_node_box(layout, list[k], G.nodes_per_dim, reach);
+      const NodeBox box =
+          tile_node_box(layout, layout.tile_of_slot(list[k]), G.nodes_per_dim, reach);
       zero_node_box<D>(G.vol, G.nodes, G.fields, G.nodes_per_dim, box);
       for (int d = 0; d < D; ++d) {
         zero_node_box<D>(G.mx[d], G.nodes, G.fields, G.nodes_per_dim, box);

@@ -20,74 +20,89 @@ namespace {
 
 using mmpm::NodeOwnership;
 
-// Sorted keys of one particle per cell in cells [lo, hi) of each direction.
+// The tile schedule of one particle per cell in cells [lo, hi) of each
+// direction, sorted.
 template <int D>
-std::vector<std::uint32_t> block_keys(const mmpm::TileLayout<D>& layout, std::array<int, 3> lo,
-                                      std::array<int, 3> hi) {
+mmpm::TileSchedule block_schedule(const mmpm::TileLayout<D>& layout, std::array<int, 3> lo,
+                                  std::array<int, 3> hi) {
   std::vector<std::uint32_t> keys;
   for (int k = D == 3 ? lo[2] : 0; k < (D == 3 ? hi[2] : 1); ++k)
     for (int j = lo[1]; j < hi[1]; ++j)
       for (int i = lo[0]; i < hi[0]; ++i) keys.push_back(layout.key({i, j, k}));
   std::sort(keys.begin(), keys.end());
-  return keys;
+  mmpm::TileSchedule schedule;
+  schedule.build(layout, keys.data(), keys.size());
+  return schedule;
 }
 
-TEST(NodeOwnership, CutsNearestTheEvenSplitInsideTheMedianTilesBand2D) {
-  // 64 x 64 cells (65 x 65 = 4225 nodes), tiles of 8: an 8 x 8 tile grid.
-  // One particle per cell in every cell: particle n/2 is the first of tile
-  // row 4, whose band is node rows 32 .. 40, and the even cut (node 2112,
-  // row 32.5) lies inside it.
-  mmpm::TileLayout<2> layout;
-  layout.setup(8, {64, 64, 1});
-  const std::array<int, 3> nodes{65, 65, 1};
-  const auto keys = block_keys<2>(layout, {0, 0, 0}, {64, 64, 1});
-  const NodeOwnership two = mmpm::node_ownership<2>(layout, nodes, keys.data(), keys.size(), 2);
-  EXPECT_EQ(two.split, (std::vector<std::size_t>{0, 2112, 65 * 65}));
-  // Four threads: tile rows 2, 4, 6 (bands from rows 16, 32, 48) hold the
-  // even cuts 1056, 2112, 3168.
-  const NodeOwnership four = mmpm::node_ownership<2>(layout, nodes, keys.data(), keys.size(), 4);
-  EXPECT_EQ(four.split, (std::vector<std::size_t>{0, 1056, 2112, 3168, 65 * 65}));
-  // Particles only in the upper-right quarter (cells 32..63): particle n/2
-  // is in tile row 6 (band rows 48 .. 56); the even cut lies below the
-  // band, so the cut is the band's first node.
-  const auto quarter = block_keys<2>(layout, {32, 32, 0}, {64, 64, 1});
-  const NodeOwnership q = mmpm::node_ownership<2>(layout, nodes, quarter.data(), quarter.size(), 2);
-  EXPECT_EQ(q.split, (std::vector<std::size_t>{0, 48 * 65, 65 * 65}));
-  // Particles only in cells x 0..31, y 0..15: particle n/2 is in tile row 1
-  // (band rows 8 .. 16); the even cut lies above, so the cut is the band's
-  // end and no node row that only thread 0 wrote goes to thread 1.
-  const auto low = block_keys<2>(layout, {0, 0, 0}, {32, 16, 1});
-  const NodeOwnership l = mmpm::node_ownership<2>(layout, nodes, low.data(), low.size(), 2);
-  EXPECT_EQ(l.split, (std::vector<std::size_t>{0, 16 * 65, 65 * 65}));
+// The cuts below come out the same with particles stored color by color
+// and in tile order: in both, each color's tiles are split in tile order.
+TEST(NodeOwnership, CutsNearestTheEvenSplitInsideTheThreadsBands2D) {
+  for (const bool color_major : {true, false}) {
+    SCOPED_TRACE(color_major ? "color-major" : "tile order");
+    // 64 x 64 cells (65 x 65 = 4225 nodes), tiles of 8: an 8 x 8 tile grid,
+    // one particle per cell in every cell. Thread 1's tiles begin in tile
+    // row 4 (colors on even rows) and 5 (odd rows): bands node rows 32 ..
+    // 48. The even cut (node 2112, row 32.5) lies inside.
+    mmpm::TileLayout<2> layout;
+    layout.setup(8, {64, 64, 1}, color_major);
+    const std::array<int, 3> nodes{65, 65, 1};
+    const auto all = block_schedule<2>(layout, {0, 0, 0}, {64, 64, 1});
+    const NodeOwnership two = mmpm::node_ownership<2>(layout, nodes, all, 2);
+    EXPECT_EQ(two.split, (std::vector<std::size_t>{0, 2112, 65 * 65}));
+    // Four threads: tile rows 2-3, 4-5, 6-7 (bands from rows 16, 32, 48)
+    // hold the even cuts 1056, 2112, 3168.
+    const NodeOwnership four = mmpm::node_ownership<2>(layout, nodes, all, 4);
+    EXPECT_EQ(four.split, (std::vector<std::size_t>{0, 1056, 2112, 3168, 65 * 65}));
+    // Particles only in the upper-right quarter (cells 32..63): thread 1's
+    // tiles begin in tile rows 6 and 7 (bands rows 48 .. 64); the even cut
+    // lies below, so the cut is the bands' first node.
+    const auto quarter = block_schedule<2>(layout, {32, 32, 0}, {64, 64, 1});
+    const NodeOwnership q = mmpm::node_ownership<2>(layout, nodes, quarter, 2);
+    EXPECT_EQ(q.split, (std::vector<std::size_t>{0, 48 * 65, 65 * 65}));
+    // Particles only in cells x 0..31, y 0..15: thread 1's tiles begin in
+    // tile rows 0 and 1 (bands rows 0 .. 16); the even cut lies above, so
+    // the cut is the bands' end and no node row that only thread 0 wrote
+    // goes to thread 1.
+    const auto low = block_schedule<2>(layout, {0, 0, 0}, {32, 16, 1});
+    const NodeOwnership l = mmpm::node_ownership<2>(layout, nodes, low, 2);
+    EXPECT_EQ(l.split, (std::vector<std::size_t>{0, 16 * 65, 65 * 65}));
+  }
 }
 
-TEST(NodeOwnership, CutsNearestTheEvenSplitInsideTheMedianTilesBand3D) {
-  // 16^3 cells (17^3 = 4913 nodes), tiles of 4: particle n/2 is the first of
-  // tile layer z = 2 (band: node layers 8 .. 12), which holds the even cut.
-  mmpm::TileLayout<3> layout;
-  layout.setup(4, {16, 16, 16});
-  const std::array<int, 3> nodes{17, 17, 17};
-  const auto keys = block_keys<3>(layout, {0, 0, 0}, {16, 16, 16});
-  const NodeOwnership two = mmpm::node_ownership<3>(layout, nodes, keys.data(), keys.size(), 2);
-  EXPECT_EQ(two.split, (std::vector<std::size_t>{0, 4913 / 2, 17 * 17 * 17}));
+TEST(NodeOwnership, CutsNearestTheEvenSplitInsideTheThreadsBands3D) {
+  for (const bool color_major : {true, false}) {
+    SCOPED_TRACE(color_major ? "color-major" : "tile order");
+    // 16^3 cells (17^3 = 4913 nodes), tiles of 4: thread 1's tiles begin in
+    // tile layers z = 2 and 3 (bands: node layers 8 .. 16), which hold the
+    // even cut.
+    mmpm::TileLayout<3> layout;
+    layout.setup(4, {16, 16, 16}, color_major);
+    const std::array<int, 3> nodes{17, 17, 17};
+    const auto all = block_schedule<3>(layout, {0, 0, 0}, {16, 16, 16});
+    const NodeOwnership two = mmpm::node_ownership<3>(layout, nodes, all, 2);
+    EXPECT_EQ(two.split, (std::vector<std::size_t>{0, 4913 / 2, 17 * 17 * 17}));
+  }
 }
 
 TEST(NodeOwnership, ThickTileLayersNoLongerLeaveOneThreadAThirdOfTheNodes) {
-  // The 3d_gimp_1mat bench geometry: 28 x 28 x 26 cells (29 x 29 x 27 =
-  // 22 707 nodes), tiles of 8, particles in cells 2..25 x 2..25 x 2..23.
-  // Particle n/2 lies in tile layer z = 1 (node layers 8 .. 16). Its tile's
-  // first node is in layer 8: a cut there gave thread 0 ~30 % of the
-  // nodes. The cut is now the even one, inside the same band.
-  mmpm::TileLayout<3> layout;
-  layout.setup(8, {28, 28, 26});
-  const std::array<int, 3> nodes{29, 29, 27};
-  const auto keys = block_keys<3>(layout, {2, 2, 2}, {26, 26, 24});
-  const NodeOwnership two = mmpm::node_ownership<3>(layout, nodes, keys.data(), keys.size(), 2);
-  const std::size_t total = 29 * 29 * 27, layer = 29 * 29;
-  EXPECT_EQ(layout.tile_of_key(keys[keys.size() / 2]) / 16, 1u);  // tile layer z = 1
-  EXPECT_EQ(two.split, (std::vector<std::size_t>{0, total / 2, total}));
-  EXPECT_GE(two.split[1], 8 * layer);
-  EXPECT_LE(two.split[1], 16 * layer);
+  for (const bool color_major : {true, false}) {
+    SCOPED_TRACE(color_major ? "color-major" : "tile order");
+    // The 3d_gimp_1mat bench geometry: 28 x 28 x 26 cells (29 x 29 x 27 =
+    // 22 707 nodes), tiles of 8, particles in cells 2..25 x 2..25 x 2..23.
+    // Thread 1's tiles begin in tile layers z = 1 or 2 (node layers 8 ..
+    // 24). A cut at the first node of layer 8 gave thread 0 ~30 % of the
+    // nodes. The cut is the even one, inside those bands.
+    mmpm::TileLayout<3> layout;
+    layout.setup(8, {28, 28, 26}, color_major);
+    const std::array<int, 3> nodes{29, 29, 27};
+    const auto block = block_schedule<3>(layout, {2, 2, 2}, {26, 26, 24});
+    const NodeOwnership two = mmpm::node_ownership<3>(layout, nodes, block, 2);
+    const std::size_t total = 29 * 29 * 27, layer = 29 * 29;
+    EXPECT_EQ(two.split, (std::vector<std::size_t>{0, total / 2, total}));
+    EXPECT_GE(two.split[1], 8 * layer);
+    EXPECT_LE(two.split[1], 24 * layer);
+  }
 }
 
 TEST(NodeOwnership, OtherTeamSizesAndNoParticlesGetAnEvenSplit) {
@@ -105,7 +120,7 @@ TEST(NodeOwnership, OtherTeamSizesAndNoParticlesGetAnEvenSplit) {
   EXPECT_EQ(own.chunks(100, 16, 2, 1), (std::pair<std::size_t, std::size_t>{1, 7}));
   mmpm::TileLayout<2> layout;
   layout.setup(8, {16, 16, 1});
-  EXPECT_TRUE(mmpm::node_ownership<2>(layout, {17, 17, 1}, nullptr, 0, 2).split.empty());
+  EXPECT_TRUE(mmpm::node_ownership<2>(layout, {17, 17, 1}, mmpm::TileSchedule{}, 2).split.empty());
 }
 
 // A grid of 2 fields with random masses (some slivers, some empty), momenta

@@ -1240,7 +1240,7 @@ TEST(TileSchedule, SharesPartitionEachColorByParticleQuantiles) {
     for (std::uint32_t t : list) {
       const std::size_t count = r.begin[t + 1] - r.begin[t];
       EXPECT_GT(count, 0u) << "only non-empty tiles are listed";
-      EXPECT_EQ(tiles.color(t), int(c));
+      EXPECT_EQ(tiles.color(tiles.tile_of_slot(t)), int(c));
       total += count, largest = std::max(largest, count);
     }
     for (std::size_t threads = 1; threads <= 4; ++threads) {

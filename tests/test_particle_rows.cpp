@@ -28,7 +28,8 @@ origin = [0.0, 0.0]
 cell = [1.0, 1.0]
 cells = [48, 24]
 tile = 4
-shape = ")" + shape +
+shape = ")" +
+         shape +
          R"("
 [[material]]
 name = "m"
@@ -106,9 +107,8 @@ TEST(ParticleRows, UnstableRunNamesTheParticleByItsRow) {
     ASSERT_NE(at, std::string::npos) << m;
     unsigned long row = 0;
     double px = 0, py = 0;
-    ASSERT_EQ(std::sscanf(m.c_str() + at, "particle %lu (material 'm', x = [%lf, %lf", &row, &px,
-                          &py),
-              3)
+    ASSERT_EQ(
+        std::sscanf(m.c_str() + at, "particle %lu (material 'm', x = [%lf, %lf", &row, &px, &py), 3)
         << m;
     ASSERT_LT(row, sim->particle_count()) << m;
     const double t = sim->time();

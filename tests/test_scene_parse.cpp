@@ -158,6 +158,7 @@ precision = "float"
 default_law = "frictionless"
 force = true
 sort_every = 5
+particle_order = "tile"
 
 [grid]
 origin = [-4.0, -4]
@@ -369,6 +370,7 @@ TEST(SceneParseValid, Full2DSceneSimulationAndGrid) {
   EXPECT_EQ(sim.default_law, Law::frictionless);
   EXPECT_TRUE(sim.force);
   EXPECT_EQ(sim.sort_every, 5);
+  EXPECT_EQ(sim.particle_order, ParticleOrder::tile);
   expect_vec(s.grid.origin, -4.0, -4.0, 0.0);
   expect_vec(s.grid.cell, 0.25, 0.5, 1.0);
   EXPECT_EQ(s.grid.cells, (std::array<int, 3>{60, 100, 1}));
@@ -549,6 +551,7 @@ TEST(SceneParseValid, DefaultsAreFilled) {
   EXPECT_EQ(sim.default_law, Law::stick);
   EXPECT_FALSE(sim.force);
   EXPECT_EQ(sim.sort_every, 0);
+  EXPECT_EQ(sim.particle_order, ParticleOrder::color);
   EXPECT_EQ(s.grid.shape, ShapeKind::gimp);
   EXPECT_DOUBLE_EQ(s.grid.damping, 0.0);
   EXPECT_EQ(s.grid.tile, 0);
@@ -792,6 +795,8 @@ TEST(SceneParseErrors, SimulationValues) {
   sim_key("thickness = 0.0", "simulation.thickness", {"expected a number > 0"});
   sim_key("dt = -1e-6", "simulation.dt", {"> 0"});
   sim_key("sort_every = -1", "simulation.sort_every", {">= 0"});
+  sim_key("particle_order = \"random\"", "simulation.particle_order",
+          {"\"color\", \"tile\"", "random"});
   sim_key("default_law = \"interface\"", "simulation.default_law",
           {"\"stick\", \"frictionless\", \"separate\""});
   sim_key("force = 1", "simulation.force", {"expected a boolean"});

@@ -1,7 +1,9 @@
 // G2P's tile-change test (kernels/binning.hpp PositionTile::any_moved): one
 // vectorised loop over a range must answer what the particle-by-particle
 // test answers, tile(position) != tile(key), for every range, wherever in
-// the range (vector body or remainder) the one moved particle sits.
+// the range (vector body or remainder) the one moved particle sits, with
+// the tiles stored color by color (keys hold color-major slots) and in
+// tile order.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -23,8 +25,8 @@ struct TileChangeCase {
 
   // n positions from two cells below the grid to two cells above it (the
   // keys clamp those into the edge cells), each keyed by its own cell.
-  TileChangeCase(int tile_edge, std::size_t n, unsigned seed) {
-    layout.setup(tile_edge, {37, 21, 13});
+  TileChangeCase(int tile_edge, bool color_major, std::size_t n, unsigned seed) {
+    layout.setup(tile_edge, {37, 21, 13}, color_major);
     std::mt19937 rng(seed);
     for (int d = 0; d < D; ++d) {
       std::uniform_real_distribution<double> u(-2.0, layout.cells[std::size_t(d)] + 2.0);
@@ -59,10 +61,11 @@ struct TileChangeCase {
 };
 
 template <int D, class Real>
-void check_tile_change(int tile_edge) {
-  SCOPED_TRACE(testing::Message() << "D " << D << ", tile edge " << tile_edge);
+void check_tile_change(int tile_edge, bool color_major) {
+  SCOPED_TRACE(testing::Message() << "D " << D << ", tile edge " << tile_edge
+                                  << (color_major ? ", color-major" : ", tile order"));
   const std::size_t n = 203;  // not a multiple of any vector width
-  TileChangeCase<D, Real> c(tile_edge, n, 11u + unsigned(tile_edge));
+  TileChangeCase<D, Real> c(tile_edge, color_major, n, 11u + unsigned(tile_edge));
   const auto test = c.test();
   ASSERT_FALSE(c.reference(0, n));
   EXPECT_FALSE(test.any_moved(c.key.data(), 0, n));
@@ -73,8 +76,8 @@ void check_tile_change(int tile_edge) {
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint32_t saved = c.key[i];
     const std::uint32_t local = saved & (c.layout.keys_per_tile - 1);
-    const std::uint32_t tile = (c.layout.tile_of_key(saved) + 1) % c.layout.tile_count;
-    c.key[i] = (tile << c.layout.key_shift) | local;
+    const std::uint32_t slot = (c.layout.slot_of_key(saved) + 1) % c.layout.tile_count;
+    c.key[i] = (slot << c.layout.key_shift) | local;
     std::uniform_int_distribution<std::size_t> below(0, i), above(i + 1, n);
     const std::size_t b = below(rng), e = above(rng);
     ASSERT_TRUE(c.reference(b, e));
@@ -88,17 +91,19 @@ void check_tile_change(int tile_edge) {
 }
 
 TEST(TileChange, AnyMovedAgreesWithTheParticleByParticleTest2D) {
-  for (int t : {4, 8, 16}) {
-    check_tile_change<2, double>(t);
-    check_tile_change<2, float>(t);
-  }
+  for (int t : {4, 8, 16})
+    for (bool color_major : {true, false}) {
+      check_tile_change<2, double>(t, color_major);
+      check_tile_change<2, float>(t, color_major);
+    }
 }
 
 TEST(TileChange, AnyMovedAgreesWithTheParticleByParticleTest3D) {
-  for (int t : {4, 8}) {
-    check_tile_change<3, double>(t);
-    check_tile_change<3, float>(t);
-  }
+  for (int t : {4, 8})
+    for (bool color_major : {true, false}) {
+      check_tile_change<3, double>(t, color_major);
+      check_tile_change<3, float>(t, color_major);
+    }
 }
 
 }  // namespace

@@ -3,7 +3,7 @@
 
 Why: twice a loop that the code and docs/performance.md called vectorised
 ran as scalar code in the solver's own build, and nothing noticed
-(PositionTile::any_moved: a member read through `this` inside an `omp simd`
+(PositionTile::any_moved, now moved_tiles: a member read through `this` inside an `omp simd`
 loop; 3D pass A of the multimaterial batch: h_perp left out of line in the
 solver's translation units). The compiler's -fopt-info on a small test file
 said "vectorized" for both, so the check has to read the binary that runs.
@@ -23,7 +23,9 @@ import sys
 
 # (name pattern, least packed FP instructions, exempt pattern or None, why)
 RULES = [
-    (r"^mmpm::PositionTile<\d, (float|double)>::any_moved\(", 2, None,
+    # any_moved picks the loop of the layout's tile order (moved_tiles<true>:
+    # color-major slots, <false>: tile indices); both must be vector loops.
+    (r"^bool mmpm::PositionTile<\d, (float|double)>::moved_tiles<(true|false)>\(", 2, None,
      "G2P's tile-change test (kernels/binning.hpp)"),
     (r"^void mmpm::mm_detail::pass_a_lanes<", 30,
      # Coulomb friction in 3D: GCC 12 rejects its masked loads

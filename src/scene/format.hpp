@@ -67,6 +67,8 @@ inline constexpr std::array<EnumName<TractionLaw>, 2> kTractionLawNames{
     {{"linear", TractionLaw::linear}, {"bilinear", TractionLaw::bilinear}}};
 inline constexpr std::array<EnumName<LoadKind>, 2> kLoadKindNames{
     {{"traction", LoadKind::traction}, {"gravity", LoadKind::gravity}}};
+inline constexpr std::array<EnumName<ParticleOrder>, 2> kParticleOrderNames{
+    {{"color", ParticleOrder::color}, {"tile", ParticleOrder::tile}}};
 
 // The full table for each enum, found by overload on a value of the enum type.
 constexpr std::span<const EnumName<Plane>> enum_names(Plane) {
@@ -104,6 +106,9 @@ constexpr std::span<const EnumName<TractionLaw>> enum_names(TractionLaw) {
 }
 constexpr std::span<const EnumName<LoadKind>> enum_names(LoadKind) {
   return kLoadKindNames;
+}
+constexpr std::span<const EnumName<ParticleOrder>> enum_names(ParticleOrder) {
+  return kParticleOrderNames;
 }
 
 // The scene-file word for an enum value: scene_name(Scheme::USL) == "USL".

@@ -26,6 +26,7 @@ enum class Separation { displacement, position };
 enum class Integration { explicit_, exact };
 enum class TractionLaw { linear, bilinear };  // bilinear: stiff in compression (ALGORITHM §3.2)
 enum class LoadKind { traction, gravity };
+enum class ParticleOrder { color, tile };  // storage order of the sorted particles
 
 // A source position for messages ("scene.toml:12: key 'E'").
 struct Where {
@@ -64,6 +65,11 @@ struct SimulationSpec {
   // in the cache; same particle results, bitwise (docs/performance.md
   // "The step's tail fused tile by tile"). false: three separate passes.
   bool fuse_step_tail = true;
+  // How the particles are stored between sorts: tile by tile, color by color
+  // (each colored pass reads its particles front to back), or in plain tile
+  // order. Same results but for the order of sums over particles
+  // (docs/performance.md "Particles stored color by color").
+  ParticleOrder particle_order = ParticleOrder::color;
   // The multimaterial fields (mx, Omega, g) are scattered apart, only from
   // tiles that reach a multimaterial node, unless more than this share of
   // the particles sits in such tiles (then with the first P2G). The values

@@ -87,12 +87,16 @@ class Stepper final : public Simulation {
   void setup_particles(const ParticleSeeds& seeds);
   void setup_grid();
   std::uint32_t key_of_position(std::size_t p) const;
-  std::uint32_t tile_of_position(std::size_t p) const {
-    return tiles_.tile_of_key(key_of_position(p));
-  }
   void sort_particles();
   void rebuild_ranges();
+  void schedule_built();
   std::pair<std::size_t, std::size_t> color_share(std::size_t color) const;
+  // The calling thread's particles in the loops that are not colored
+  // (TileSchedule::thread_ranges): the particles of its colored passes.
+  TileSchedule::Ranges my_particles() const {
+    return schedule_.thread_ranges(std::size_t(omp_get_num_threads()),
+                                   std::size_t(omp_get_thread_num()));
+  }
   void zero_grid(bool mm);
   template <unsigned What>
   void p2g(const char* stage_label);

@@ -78,7 +78,7 @@ void Stepper<D, Shape, Real>::setup_grid() {
       if (tiles >= std::size_t(32) << D) break;
     }
   }
-  tiles_.setup(T, g.cells);
+  tiles_.setup(T, g.cells, scene_.simulation.particle_order == ParticleOrder::color);
 }
 
 template <int D, class Shape, class Real>
@@ -207,16 +207,20 @@ void Stepper<D, Shape, Real>::sort_particles() {
   const std::size_t n = P_.n;
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
   for (std::size_t p = 0; p < n; ++p) P_.key[p] = key_of_position(p);
-  counting_sort(P_.key, n, tiles_.key_count(), offsets_, perm_);
-  scratch_.resize(n);
-  for (auto& col : pcols_.reals) permute_in_place(col.data(), scratch_.data(), perm_.data(), n);
-  scratch_bytes_.resize(n);
-  for (auto& col : pcols_.bytes)
-    permute_in_place(col.data(), scratch_bytes_.data(), perm_.data(), n);
+  counting_sort(P_.key, n, tiles_.key_count(), offsets_, perm_, pcols_.id.data());
+  // The keys first: the schedule of the new order says which thread's
+  // loops take which particles, and so where every other column goes.
   scratch_keys_.resize(n);
   permute_in_place(P_.key, scratch_keys_.data(), perm_.data(), n);
-  permute_in_place(pcols_.id.data(), scratch_keys_.data(), perm_.data(), n);
-  rebuild_ranges();
+  schedule_.build(tiles_, P_.key, n);
+  permute_in_place(pcols_.id.data(), scratch_keys_.data(), perm_.data(), n, &schedule_);
+  scratch_.resize(n);
+  for (auto& col : pcols_.reals)
+    permute_in_place(col.data(), scratch_.data(), perm_.data(), n, &schedule_);
+  scratch_bytes_.resize(n);
+  for (auto& col : pcols_.bytes)
+    permute_in_place(col.data(), scratch_bytes_.data(), perm_.data(), n, &schedule_);
+  schedule_built();
   dirty_ = false;
   grid_ready_ = false;  // a P2G in the old order
 }
@@ -319,8 +323,14 @@ double Stepper<D, Shape, Real>::grid_kinetic_energy() const {
 // Tile ranges, color lists and per-material lists from the (sorted) keys.
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::rebuild_ranges() {
+  schedule_.build(tiles_, P_.key, P_.n);
+  schedule_built();
+}
+
+// What follows the tile schedule: node split, mixed tiles, material lists.
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::schedule_built() {
   const std::size_t n = P_.n;
-  schedule_.build(tiles_, P_.key, n);
   update_node_ownership(true);
   if (plan_.multimaterial) mixed_tiles_.build(tiles_, G_.nodes_per_dim, schedule_.begin, P_.field);
   if (!material_particles_.empty()) {
@@ -344,7 +354,7 @@ void Stepper<D, Shape, Real>::update_node_ownership(bool rebuilt) {
   const auto threads = std::size_t(omp_get_max_threads());
   if (!rebuilt && own_threads_ == threads) return;
   own_threads_ = threads;
-  own_ = node_ownership<D>(tiles_, G_.nodes_per_dim, P_.key, P_.n, threads);
+  own_ = node_ownership<D>(tiles_, G_.nodes_per_dim, schedule_, threads);
 }
 
 template <int D, class Shape, class Real>
@@ -487,10 +497,18 @@ void Stepper<D, Shape, Real>::g2p() {
   const G2PParams q = g2p_params();
   const std::size_t n = P_.n, chunks = chunk_count(n);
   std::vector<G2PRangeResult> res(chunks);
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (std::size_t c = 0; c < chunks; ++c) {
-    const std::size_t b = c * kReduceChunk, e = std::min(n, b + kReduceChunk);
-    res[c] = g2p_range_of<What>(q, b, e);
+  // Fixed chunks (the external work sums in chunk order whatever the
+  // threads), each run by the thread whose particles it begins in.
+#pragma omp parallel if (n >= kParallelMin)
+  {
+    const TileSchedule::Ranges mine = my_particles();
+    for (std::size_t r = 0; r < mine.count; ++r) {
+      const auto [first, last] = mine.range[r];
+      for (std::size_t c = chunk_count(first); c * kReduceChunk < last; ++c) {
+        const std::size_t b = c * kReduceChunk, e = std::min(n, b + kReduceChunk);
+        res[c] = g2p_range_of<What>(q, b, e);
+      }
+    }
   }
   collect(res);
 }
@@ -511,23 +529,22 @@ void Stepper<D, Shape, Real>::g2p_colored() {
   collect(res);
 }
 
-// One parallel region for all materials, each thread on its own
-// contiguous block of particles (the block of the static particle loops,
-// kernels/binning.hpp TileSchedule): a material's list is cut at the block's ends, so a
-// thread updates only particles it touched in the passes before and the
-// threads share the work of every material without a barrier per material.
-// Then each thread checks its own block for inverted or blown-up particles
-// (non-positive or non-finite volume, non-finite stress) while the block is
-// still in its cache.
+// One parallel region for all materials, each thread on its own particles
+// (TileSchedule::thread_ranges): a material's list is cut at the ranges'
+// ends, so a thread updates only particles it touched in the passes before
+// and the threads share the work of every material without a barrier per
+// material. Then each thread checks its own ranges for inverted or blown-up
+// particles (non-positive or non-finite volume, non-finite stress) while
+// they are still in its cache.
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::constitutive() {
   const std::size_t n = P_.n;
   std::size_t bad = SIZE_MAX;
 #pragma omp parallel reduction(min : bad) if (n >= kParallelMin)
   {
-    const auto [lo, hi] =
-        thread_block(n, std::size_t(omp_get_num_threads()), std::size_t(omp_get_thread_num()));
-    bad = std::min(bad, constitutive_range(lo, hi));
+    const TileSchedule::Ranges mine = my_particles();
+    for (std::size_t r = 0; r < mine.count; ++r)
+      bad = std::min(bad, constitutive_range(mine.range[r].first, mine.range[r].second));
   }
   if (bad != SIZE_MAX) fail_particle("constitutive", bad, "J <= 0 or a non-finite stress/volume");
 }
@@ -669,10 +686,14 @@ void Stepper<D, Shape, Real>::update_tractions() {
     const double tm = time_ + 0.5 * dt_;
     scale[l] = Real(ramp_fraction(tm, r));
   }
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (std::size_t p = 0; p < n; ++p) {
-    const Real s = load[p] == 255 ? Real(0) : scale[load[p]];
-    for (int d = 0; d < D; ++d) P_.fext[d][p] = s * base[d][p];
+#pragma omp parallel if (n >= kParallelMin)
+  {
+    const TileSchedule::Ranges mine = my_particles();
+    for (std::size_t r = 0; r < mine.count; ++r)
+      for (std::size_t p = mine.range[r].first; p < mine.range[r].second; ++p) {
+        const Real s = load[p] == 255 ? Real(0) : scale[load[p]];
+        for (int d = 0; d < D; ++d) P_.fext[d][p] = s * base[d][p];
+      }
   }
 }
 
@@ -808,8 +829,7 @@ void Stepper<D, Shape, Real>::fail_particle(const char* stage, std::size_t p,
   std::ostringstream os;
   // The seed index: the particle's row in the outputs (p is where the sorts put it).
   os << "unstable: stage " << stage << ", step " << step_ << ", particle " << pcols_.id[p]
-     << " (material '"
-     << materials_[P_.mat[p]].name << "', x = [";
+     << " (material '" << materials_[P_.mat[p]].name << "', x = [";
   for (int d = 0; d < D; ++d) os << (d ? ", " : "") << double(P_.x[d][p]);
   os << "]): " << why;
   throw SimulationError(os.str());
@@ -963,8 +983,9 @@ io::ParticleField Stepper<D, Shape, Real>::particle_field(const std::string& nam
   } else if (name == "material" || name == "mass" || name == "volume") {
     out.values.resize(n);
     for (std::size_t p = 0; p < n; ++p)
-      out.values[row[p]] = name == "material" ? double(P_.mat[p])
-                                         : (name == "mass" ? double(P_.m[p]) : double(P_.V[p]));
+      out.values[row[p]] = name == "material"
+                               ? double(P_.mat[p])
+                               : (name == "mass" ? double(P_.m[p]) : double(P_.V[p]));
   } else {
     throw InputError("output field '" + name +
                      "' is unknown (position, displacement, velocity, stress, strain, "
@@ -1010,7 +1031,8 @@ std::vector<io::Blob> Stepper<D, Shape, Real>::save_state() const {
         "b." + pcols_.byte_names[c],
         std::vector<std::uint8_t>(pcols_.bytes[c].data(), pcols_.bytes[c].data() + n)));
   out.push_back(io::make_blob("key", std::vector<std::uint32_t>(P_.key, P_.key + n)));
-  out.push_back(io::make_blob("id", std::vector<std::uint32_t>(pcols_.id.data(), pcols_.id.data() + n)));
+  out.push_back(
+      io::make_blob("id", std::vector<std::uint32_t>(pcols_.id.data(), pcols_.id.data() + n)));
   out.push_back(io::make_scalar_blob("step", step_));
   out.push_back(io::make_scalar_blob("time", time_));
   out.push_back(io::make_scalar_blob("external_work", external_work_));
