@@ -1,19 +1,30 @@
-// mmpm_roofline: how close the hot kernels run to this machine's limits.
+// mmpm_roofline: how close the hot kernels and the whole step run to this
+// machine's limits (docs/performance.md "Roofline counts").
 //
-// 1. Measures the machine: STREAM-like triad bandwidth (a = b + s c, 3
-//    arrays of 2^24 doubles, best of 5; bytes counted as 4 per element moved
-//    because the store allocates its line) and the peak FMA rate (16
-//    independent vector FMA chains per thread, 2 flops per lane).
-// 2. Runs whole-solver steps (USL, one material, a block filling the grid)
-//    for each case and takes the per-stage times from the Stepper's timers,
-//    best of 5 blocks of K steps.
-// 3. Counts, per particle and step, the compulsory bytes each stage must
-//    move (particle arrays read/written once; grid arrays read and written
-//    once per step, amortised over the particles) and the flops of the
-//    kernel's arithmetic (docs/performance.md derives the counts), and prints
-//    achieved GB/s and GFLOP/s next to the bound
-//    max(bytes / bandwidth, flops / peak) and the ratio time / bound.
-// Usage: mmpm_roofline [--threads N] [--steps K] [--only TEXT]
+// 1. The machine: STREAM-like triad bandwidth (a = b + s c, 3 arrays of 2^24
+//    doubles, bytes counted as 4 per element moved because the store
+//    allocates its line) and the peak FMA rate (16 independent vector FMA
+//    chains per thread, 2 flops per lane).
+// 2. Whole-solver steps of a block filling the grid (one material), for
+//    each case in the default scheme (MUSL, its step tail fused: P2G runs
+//    inside the tail on columns the tail's G2P has just read) and in USL
+//    (one transfer each way, every pass on its own), per-stage times from
+//    the Stepper's timers, in blocks of K steps.
+// 3. Paired with the machine: a triad runs right before and right after
+//    every block (then one untimed step, so the block does not start on
+//    caches the triad emptied), and each block's ratio time / bound uses the
+//    mean of its two triads. This host's bandwidth moves by 25 % within
+//    minutes (other tenants), so a bound from a triad measured once, minutes
+//    away from the kernel, says little. Reported: the median of the
+//    blocks' ratios, and best time / bound at the best triad.
+// 4. Counts, per particle and step, the compulsory bytes (every persistent
+//    particle column a stage reads read once, every one it writes written
+//    once; grid arrays read and written once per step, amortised over the
+//    particles) and the flops of the pointwise arithmetic; the bound is
+//    max(bytes / triad bandwidth, flops / peak). The "step" row counts the
+//    columns of the whole step once: how far the step is from streaming
+//    its particles once per step.
+// Usage: mmpm_roofline [--threads N] [--steps K] [--blocks B] [--only TEXT]
 //   --only runs the cases whose label contains TEXT (e.g. "2D linear").
 #include <omp.h>
 
@@ -24,6 +35,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <iterator>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -37,28 +49,38 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-double triad_bandwidth(int threads) {
-  const std::size_t n = std::size_t(1) << 24;
-  std::vector<double> a(n), b(n, 1.0), c(n, 2.0);
-  omp_set_num_threads(threads);
+// The triad's arrays, allocated and first touched once (by the threads that
+// use them).
+struct Triad {
+  static constexpr std::size_t n = std::size_t(1) << 24;
+  std::unique_ptr<double[]> a{new double[n]}, b{new double[n]}, c{new double[n]};
+  explicit Triad(int threads) {
+    omp_set_num_threads(threads);
 #pragma omp parallel for schedule(static)
-  for (std::size_t i = 0; i < n; ++i) a[i] = 0.0;  // first touch
-  double best = 1e30;
-  for (int rep = 0; rep < 5; ++rep) {
-    const auto t0 = Clock::now();
-    const double s = 1.0 + rep * 1e-9;
-#pragma omp parallel for schedule(static)
-    for (std::size_t i = 0; i < n; ++i) a[i] = b[i] + s * c[i];
-    best = std::min(best, seconds_since(t0));
+    for (std::size_t i = 0; i < n; ++i) a[i] = 0.0, b[i] = 1.0, c[i] = 2.0;
   }
-  volatile double sink = a[n / 2];
-  (void)sink;
-  return 4.0 * 8.0 * double(n) / best / 1e9;
-}
+  // GB/s, best of `reps` passes.
+  double measure(int threads, int reps) {
+    omp_set_num_threads(threads);
+    double best = 1e30;
+    double* __restrict x = a.get();
+    const double* __restrict y = b.get();
+    const double* __restrict z = c.get();
+    for (int rep = 0; rep < reps; ++rep) {
+      const auto t0 = Clock::now();
+      const double s = 1.0 + rep * 1e-9;
+#pragma omp parallel for schedule(static)
+      for (std::size_t i = 0; i < n; ++i) x[i] = y[i] + s * z[i];
+      best = std::min(best, seconds_since(t0));
+    }
+    volatile double sink = a[n / 2];
+    (void)sink;
+    return 4.0 * 8.0 * double(n) / best / 1e9;
+  }
+};
 
-double peak_gflops(int threads) {
+double peak_gflops(int threads, long iters = 20000000) {
   constexpr int kChains = 16, kLanes = 8;
-  const long iters = 20000000;
   omp_set_num_threads(threads);
   double total_flops = 0;
   const auto t0 = Clock::now();
@@ -89,12 +111,11 @@ struct Case {
   int S;  // stencil width per direction
 };
 
-std::string block_scene(const Case& c) {
+std::string block_scene(const Case& c, const char* scheme) {
   const bool d3 = c.dim == 3;
-  std::string s =
-      "[simulation]\ndimension = " + std::to_string(c.dim) +
-      "\nend_time = 1.0\ncfl = 0.5\nscheme = \"USL\"\nfuse_constitutive = false\nprecision = \"" +
-      c.precision + "\"\n";
+  std::string s = "[simulation]\ndimension = " + std::to_string(c.dim) +
+                  "\nend_time = 1.0\ncfl = 0.5\nscheme = \"" + scheme + "\"\nprecision = \"" +
+                  c.precision + "\"\n";
   s += d3 ? "[grid]\norigin = [-2.0, -2.0, -2.0]\ncell = [1.0, 1.0, 1.0]\ncells = [54, 54, 54]\n"
           : "[grid]\norigin = [-2.0, -2.0]\ncell = [1.0, 1.0]\ncells = [254, 254]\n";
   s += std::string("shape = \"") + c.shape + "\"\n";
@@ -107,15 +128,64 @@ std::string block_scene(const Case& c) {
   return s;
 }
 
+// Bytes and flops per particle and step of one row (docs/performance.md
+// derives the counts).
+struct Row {
+  const char* stage;
+  int idx;  // Stepper stage, or -1: the whole step
+  double bytes, flops;
+};
+
+std::vector<Row> rows_of(const Case& c, bool musl, double nodes_per_particle) {
+  const int D = c.dim, NS = D == 2 ? 4 : 6, nodes = D == 2 ? c.S * c.S : c.S * c.S * c.S;
+  const double R = std::strcmp(c.precision, "double") == 0 ? 8.0 : 4.0;
+  const int lp = std::strcmp(c.shape, "gimp") == 0 ? D : 0;  // uGIMP half-widths
+  const double grid = nodes_per_particle * R * 2.0;  // one grid array read + written per step
+  // The force needs the in-plane stresses only: 3 of the 4 in 2D (not zz).
+  const int NS_force = D == 2 ? 3 : 6;
+  const double p2g_bytes = R * (2 * D + 2 + NS_force + lp) + grid * (1 + 2 * D);
+  // USL's G2P reads x, (lp), v and writes v, x, L; MUSL's two passes (the
+  // first scatters m v, the gradient pass moves x) read m too, once.
+  const double g2p_bytes =
+      R * (2 * D + lp + (musl ? 1 : 0)) + 4 + R * (2 * D + D * D) + grid / 2 * (2 * D);
+  const double con_bytes = R * (D * D + NS + 1) + R * (NS + 1);
+  // The step: every persistent column once; reads x, v, m, V, sigma, (lp),
+  // key; writes x, v, V, sigma, L; the grid's m, p, f, vel, dvel.
+  const double step_bytes =
+      R * (2 * D + 2 + NS + lp) + 4 + R * (2 * D + 1 + NS + D * D) + grid * (1 + 4 * D);
+  const double stencil = D * (c.S == 2 ? 4.0 : 14.0) + nodes * (D + 1.0);
+  const double p2g_flops = stencil + 2 * D + NS + nodes * (2.0 + 2 * D + 4.0 * D);
+  const double one_g2p = stencil + nodes * (4.0 * D + 2.0 * D * D) + 6 * D;
+  // MUSL: a second gather (the velocity, then its gradient) and the
+  // momentum scatter's n (1 + D) products and sums.
+  const double g2p_flops = musl ? 2 * one_g2p + nodes * 2.0 * (1 + D) : one_g2p;
+  const double con_flops = D == 2 ? 30 : 60;
+  return {{"p2g", mmpm::kStageP2G, p2g_bytes, p2g_flops},
+          {"g2p", mmpm::kStageG2P, g2p_bytes, g2p_flops},
+          {"constitutive", mmpm::kStageConstitutive, con_bytes, con_flops},
+          {"step", -1, step_bytes, p2g_flops + g2p_flops + con_flops}};
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  int threads = 1, steps = 20;
+  int threads = 1, steps = 20, blocks = 7;
   const char* only = nullptr;
   for (int i = 1; i + 1 < argc; ++i) {
     if (!std::strcmp(argv[i], "--only")) only = argv[i + 1];
     if (!std::strcmp(argv[i], "--threads")) threads = std::atoi(argv[i + 1]);
     if (!std::strcmp(argv[i], "--steps")) steps = std::atoi(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--blocks")) blocks = std::atoi(argv[i + 1]);
+  }
+  if (threads < 1 || steps < 1 || blocks < 1) {
+    std::fprintf(stderr, "mmpm_roofline: --threads, --steps and --blocks take integers >= 1\n");
+    return 2;
   }
   const Case cases[] = {{"2D linear double", 2, "linear", "double", 2},
                         {"2D gimp double", 2, "gimp", "double", 3},
@@ -128,70 +198,98 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, ")\n");
     return 2;
   }
-  const double bw = triad_bandwidth(threads), peak = peak_gflops(threads);
-  std::printf("machine (%d thread%s): triad %.1f GB/s, peak FMA %.1f GFLOP/s (double, 8 lanes)\n\n",
-              threads, threads > 1 ? "s" : "", bw, peak);
-  std::printf("%-22s %-13s %9s %9s %9s %8s %8s %9s %7s\n", "case", "stage", "ns/part", "B/part",
-              "flop/part", "GB/s", "GFLOP/s", "bound ns", "x bound");
+  Triad triad(threads);
+  // The machine right now: a triad (best of 3) and a short peak-FMA run.
+  struct Machine {
+    double gbs = 0, gflops = 0;
+  };
+  auto machine_now = [&] {
+    Machine m{triad.measure(threads, 3), peak_gflops(threads, 4000000)};
+    omp_set_num_threads(threads);
+    return m;
+  };
+  std::printf(
+      "machine (%d thread%s): triad (a = b + s c, 3 x 128 MiB) and peak FMA (double, 8 lanes) "
+      "measured around every block of %d steps, %d blocks per case and scheme\n\n",
+      threads, threads > 1 ? "s" : "", steps, blocks);
+  std::printf("%-17s %-5s %-12s %8s %6s %6s %7s %7s %8s %8s %8s %12s %12s\n", "case", "sch.",
+              "stage", "ns/part", "B/part", "fl/p", "GB/s", "GFLOP/s", "bound ns", "x bound",
+              "x b. min", "triad GB/s", "peak GFLOP/s");
+  std::vector<double> all_gbs, all_gflops;
   for (const Case& c : cases) {
     if (!selected(c)) continue;
-    mmpm::Scene scene;
-    try {
-      scene = mmpm::parse_scene_text(block_scene(c), "roofline.toml");
-    } catch (const std::exception& e) {
-      std::printf("%s: %s\n", c.label, e.what());
-      continue;
-    }
-    std::unique_ptr<mmpm::Simulation> sim;
-    try {
-      sim = mmpm::make_simulation(scene);
-    } catch (const std::exception& e) {
-      std::printf("%-22s skipped: %s\n", c.label, e.what());
-      continue;
-    }
-    omp_set_num_threads(threads);
-    sim->step();  // first step sorts; not timed
-    // Best of 5 blocks of `steps` steps per stage: one block is one sample
-    // of a shared host's load (the triad is best of 5 too).
-    std::array<double, mmpm::kStageCount> best;
-    best.fill(1e30);
-    for (int rep = 0; rep < 5; ++rep) {
-      const auto before = sim->stage_seconds();
-      for (int k = 0; k < steps; ++k) sim->step();
-      const auto after = sim->stage_seconds();
-      for (int st = 0; st < mmpm::kStageCount; ++st)
-        best[std::size_t(st)] = std::min(best[std::size_t(st)], after[st] - before[st]);
-    }
-    const double np = double(sim->particle_count()), nn = double(sim->node_count());
-    const int D = c.dim, NS = D == 2 ? 4 : 6, nodes = D == 2 ? c.S * c.S : c.S * c.S * c.S;
-    const double R = std::strcmp(c.precision, "double") == 0 ? 8.0 : 4.0;
-    const bool gimp = std::strcmp(c.shape, "gimp") == 0;
-    // Compulsory traffic per particle (docs/performance.md).
-    const double grid_per_p = nn / np * R * 2.0;  // one array read + written once per step
-    // The force needs the in-plane stresses only: 3 of the 4 in 2D (not zz).
-    const int NS_force = D == 2 ? 3 : 6;
-    const double p2g_bytes = R * (2 * D + 2 + NS_force + (gimp ? D : 0)) + grid_per_p * (1 + 2 * D);
-    const double g2p_bytes =
-        R * (2 * D + (gimp ? D : 0)) + 4 + R * (2 * D + D * D) + grid_per_p / 2 * (2 * D);
-    const double con_bytes = R * (D * D + NS + 1) + R * (NS + 1);
-    const double stencil_flops = D * (c.S == 2 ? 4.0 : 14.0) + nodes * (D + 1.0);
-    const double p2g_flops = stencil_flops + 2 * D + NS + nodes * (2.0 + 2 * D + 4.0 * D);
-    const double g2p_flops = stencil_flops + nodes * (4.0 * D + 2.0 * D * D) + 6 * D;
-    const double con_flops = D == 2 ? 30 : 60;
-    struct Row {
-      const char* stage;
-      int idx;
-      double bytes, flops;
-    } rows[] = {{"p2g", mmpm::kStageP2G, p2g_bytes, p2g_flops},
-                {"g2p", mmpm::kStageG2P, g2p_bytes, g2p_flops},
-                {"constitutive", mmpm::kStageConstitutive, con_bytes, con_flops}};
-    const double peak_real = R == 8.0 ? peak : 2 * peak;
-    for (const Row& r : rows) {
-      const double t = best[std::size_t(r.idx)] / steps / np * 1e9;      // ns per particle
-      const double bound = std::max(r.bytes / bw, r.flops / peak_real);  // ns (bytes / (GB/s) = ns)
-      std::printf("%-22s %-13s %9.2f %9.0f %9.0f %8.2f %8.2f %9.2f %7.2f\n", c.label, r.stage, t,
-                  r.bytes, r.flops, r.bytes / t, r.flops / t, bound, t / bound);
+    for (const char* scheme : {"MUSL", "USL"}) {
+      std::unique_ptr<mmpm::Simulation> sim;
+      try {
+        sim =
+            mmpm::make_simulation(mmpm::parse_scene_text(block_scene(c, scheme), "roofline.toml"));
+      } catch (const std::exception& e) {
+        std::printf("%-17s %-5s skipped: %s\n", c.label, scheme, e.what());
+        continue;
+      }
+      omp_set_num_threads(threads);
+      sim->step();  // the first step sorts; not timed
+      const double np = double(sim->particle_count()), nn = double(sim->node_count());
+      const bool musl = std::strcmp(scheme, "MUSL") == 0;
+      const std::vector<Row> rows = rows_of(c, musl, nn / np);
+      // float runs twice the lanes of the double peak
+      const double lanes = std::strcmp(c.precision, "double") == 0 ? 1.0 : 2.0;
+      // Per block: each row's ns per particle, and the machine around it.
+      std::vector<std::vector<double>> t(rows.size());
+      std::vector<Machine> at;
+      for (int b = 0; b < blocks; ++b) {
+        const Machine before = machine_now();
+        sim->step();  // after the triad: caches as a run's step finds them
+        const auto s0 = sim->stage_seconds();
+        const auto w0 = Clock::now();
+        for (int k = 0; k < steps; ++k) sim->step();
+        const double wall = seconds_since(w0);
+        const auto s1 = sim->stage_seconds();
+        const Machine after = machine_now();
+        at.push_back({0.5 * (before.gbs + after.gbs), 0.5 * (before.gflops + after.gflops)});
+        for (const Machine& m : {before, after})
+          all_gbs.push_back(m.gbs), all_gflops.push_back(m.gflops);
+        for (std::size_t r = 0; r < rows.size(); ++r) {
+          const double sec = rows[r].idx < 0 ? wall : s1[rows[r].idx] - s0[rows[r].idx];
+          t[r].push_back(sec / steps / np * 1e9);
+        }
+      }
+      Machine best;
+      for (const Machine& m : at)
+        best.gbs = std::max(best.gbs, m.gbs), best.gflops = std::max(best.gflops, m.gflops);
+      double low_gbs = best.gbs, low_gflops = best.gflops;
+      for (const Machine& m : at)
+        low_gbs = std::min(low_gbs, m.gbs), low_gflops = std::min(low_gflops, m.gflops);
+      for (std::size_t r = 0; r < rows.size(); ++r) {
+        const Row& row = rows[r];
+        auto bound = [&](const Machine& m) {  // ns: bytes / (GB/s) = ns
+          return std::max(row.bytes / m.gbs, row.flops / (lanes * m.gflops));
+        };
+        std::vector<double> ratio;
+        for (int b = 0; b < blocks; ++b) ratio.push_back(t[r][b] / bound(at[std::size_t(b)]));
+        const double tmin = *std::min_element(t[r].begin(), t[r].end());
+        std::printf(
+            "%-17s %-5s %-12s %8.2f %6.0f %6.0f %7.2f %7.2f %8.2f %8.2f %8.2f %5.1f-%-6.1f "
+            "%5.0f-%-6.0f\n",
+            c.label, scheme, row.stage, tmin, row.bytes, row.flops, row.bytes / tmin,
+            row.flops / tmin, bound(best), median(ratio), tmin / bound(best), low_gbs, best.gbs,
+            low_gflops, best.gflops);
+      }
     }
   }
+  std::printf(
+      "\nns/part: best block. bound ns: max(bytes / triad, flops / peak) at the best triad and "
+      "peak. x bound: median over the blocks of time / bound at the block's own machine "
+      "(mean of the measurements before and after it); x b. min: best time / best bound. "
+      "Below 1: the stage found columns in the cache that the count charges to memory (the "
+      "constitutive update reads L and sigma right after the G2P that wrote L).\n");
+  if (all_gbs.empty()) return 1;  // every case was skipped
+  std::printf(
+      "Over the run: triad %.1f to %.1f GB/s (median %.1f), peak %.0f to %.0f GFLOP/s "
+      "(median %.0f).\n",
+      *std::min_element(all_gbs.begin(), all_gbs.end()),
+      *std::max_element(all_gbs.begin(), all_gbs.end()), median(all_gbs),
+      *std::min_element(all_gflops.begin(), all_gflops.end()),
+      *std::max_element(all_gflops.begin(), all_gflops.end()), median(all_gflops));
   return 0;
 }
