@@ -31,6 +31,7 @@
 
 #include "scene/parse.hpp"
 #include "solver/simulation.hpp"
+#include "validation_util.hpp"
 
 namespace {
 
@@ -46,15 +47,9 @@ std::vector<std::string> with(std::vector<std::string> sets, bool fuse) {
 // Every particle field the solver reports, the energies and the reactions:
 // equal bit for bit.
 void expect_bitwise_same(const Simulation& a, const Simulation& b, const std::string& what) {
-  for (const char* name : {"position", "displacement", "velocity", "stress", "strain", "volume"}) {
-    const auto x = a.particle_field(name).values;
-    const auto y = b.particle_field(name).values;
-    ASSERT_EQ(x.size(), y.size()) << what << " " << name;
-    std::size_t differ = 0;
-    for (std::size_t i = 0; i < x.size(); ++i)
-      if (std::memcmp(&x[i], &y[i], sizeof(double)) != 0) ++differ;
-    EXPECT_EQ(differ, 0u) << what << " " << name << ": values differing";
-  }
+  for (const char* name : {"position", "displacement", "velocity", "stress", "strain", "volume"})
+    EXPECT_EQ(mmpm::testing::differing_values(a, b, name), 0u)
+        << what << " " << name << ": values differing";
   const Energies e = a.energies(), g = b.energies();
   EXPECT_EQ(e.kinetic, g.kinetic) << what;
   EXPECT_EQ(e.strain, g.strain) << what;

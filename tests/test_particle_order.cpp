@@ -22,6 +22,7 @@
 #include "kernels/binning.hpp"
 #include "scene/parse.hpp"
 #include "solver/simulation.hpp"
+#include "validation_util.hpp"
 
 namespace {
 
@@ -29,8 +30,8 @@ using namespace mmpm;
 
 template <int D>
 void check_slots(const std::array<int, 3>& cells, int edge) {
-  SCOPED_TRACE(testing::Message() << D << "D, cells " << cells[0] << " x " << cells[1] << " x "
-                                  << cells[2] << ", tile edge " << edge);
+  SCOPED_TRACE(::testing::Message() << D << "D, cells " << cells[0] << " x " << cells[1] << " x "
+                                    << cells[2] << ", tile edge " << edge);
   TileLayout<D> color, tile;
   color.setup(edge, cells, true);
   tile.setup(edge, cells, false);
@@ -127,14 +128,9 @@ Scene with_order(const std::string& file, std::vector<std::string> sets, const c
 }
 
 void expect_same(const Simulation& a, const Simulation& b, const std::string& what) {
-  for (const char* name : {"position", "velocity", "stress", "volume"}) {
-    const auto x = a.particle_field(name).values, y = b.particle_field(name).values;
-    ASSERT_EQ(x.size(), y.size()) << what << " " << name;
-    std::size_t differ = 0;
-    for (std::size_t i = 0; i < x.size(); ++i)
-      if (std::memcmp(&x[i], &y[i], sizeof(double)) != 0) ++differ;
-    EXPECT_EQ(differ, 0u) << what << " " << name << ": values differing";
-  }
+  for (const char* name : {"position", "velocity", "stress", "volume"})
+    EXPECT_EQ(mmpm::testing::differing_values(a, b, name), 0u)
+        << what << " " << name << ": values differing";
   const Energies e = a.energies(), g = b.energies();
   const double scale = std::abs(e.kinetic) + std::abs(e.strain) + std::abs(e.interface) +
                        std::abs(e.external_work) + 1e-300;

@@ -5,7 +5,9 @@
 #include <omp.h>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
+#include <cstring>
 #include <memory>
 #include <string>
 #include <vector>
@@ -14,6 +16,18 @@
 #include "solver/simulation.hpp"
 
 namespace mmpm::testing {
+
+// How many values of particle field `name` differ bit for bit between two
+// runs (SIZE_MAX: the fields differ in size).
+inline std::size_t differing_values(const Simulation& a, const Simulation& b,
+                                    const std::string& name) {
+  const auto x = a.particle_field(name).values, y = b.particle_field(name).values;
+  if (x.size() != y.size()) return SIZE_MAX;
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < x.size(); ++i)
+    if (std::memcmp(&x[i], &y[i], sizeof(double)) != 0) ++differ;
+  return differ;
+}
 
 inline std::unique_ptr<Simulation> make_from_text(const std::string& toml,
                                                   const std::vector<std::string>& overrides = {}) {
