@@ -406,35 +406,50 @@ def step_section(R):
     return out
 
 
+# The settings step_ab compares with the defaults (bench/bench_step_ab.cpp):
+# label, heading, what A and B run, what a ratio > 1 means, the stage column.
+PAIRED_SETTINGS = [
+    ("fuse_step_tail_false", "The fused step tail, paired blocks (B: fuse_step_tail = false)",
+     "A with the defaults (MUSL's gradient G2P, constitutive update and next P2G fused tile by "
+     "tile) and B with the three passes apart", "the fused tail is faster", "p2g"),
+    ("particle_order_tile", "Particles stored color by color, paired blocks "
+     "(B: particle_order = \"tile\")",
+     "A with the defaults (particles stored color by color, so each colored pass reads them "
+     "front to back) and B stored in plain tile order", "color order is faster", "g2p"),
+]
+
+
 def paired_setting_table(R):
     """step_ab/... (bench/bench_step_ab.cpp): two Simulations of a scene, A
     with the defaults and B with one setting changed, alternate blocks of
-    steps on the same threads. Per thread count: the median over the passes
-    of the median paired ratio t(B) / t(A), [the ratio of the minima], (A →
-    B ns/particle/step, minima), and P2G's share likewise."""
+    steps on the same threads. Per setting and thread count: the median over
+    the passes of the median paired ratio t(B) / t(A), [the ratio of the
+    minima], (A → B ns/particle/step, minima), and one stage likewise."""
     scenes = [(scene, label) for scene, label, kw in step_scenes() if len(kw) == 1]
-    rows = []
-    for scene, label in scenes:
-        for t in (1, 2):
-            kw = dict(scene=scene, b="fuse_step_tail_false", threads=t)
-            r = R.value("step_ab", "b_over_a_step", stat="median", **kw)
-            if r is None:
-                continue
-            rm = R.value("step_ab", "b_over_a_step_min", stat="median", **kw)
-            a, b = (R.value("step_ab", f"ns{x}_step", stat="min", **kw) for x in "AB")
-            pa, pb = (R.value("step_ab", f"ns{x}_p2g", stat="min", **kw) for x in "AB")
-            rows.append([f"`{scene}`: {label}", str(t), f"{r:.3f} [{rm:.3f}]",
-                         f"{fmt(a)} → {fmt(b)}", f"{fmt(pa, 2)} → {fmt(pb, 2)}"])
-    if not rows:
-        return []
-    return ["", "### The fused step tail, paired blocks (B: fuse_step_tail = false)", "",
-            "`step_ab/scene:.../b:fuse_step_tail_false`: two simulations of the scene, A with the "
-            "defaults (MUSL's gradient G2P, constitutive update and next P2G fused tile by tile) "
-            "and B with the three passes apart, alternate blocks of 4 steps (A,B / B,A / ...; one "
-            "untimed step opens each block). Ratio: median over the pairs of t(B) / t(A) (> 1: "
-            "the fused tail is faster), [ratio of the minima]; ns/particle/step, minima, A → B; "
-            "the p2g column is the stage, in A its measured share of the fused pass.", "",
-            table(["scene", "threads", "B / A", "step A → B", "p2g A → B"], rows)]
+    out = []
+    for b_label, heading, what, faster, stage in PAIRED_SETTINGS:
+        rows = []
+        for scene, label in scenes:
+            for t in (1, 2):
+                kw = dict(scene=scene, b=b_label, threads=t)
+                r = R.value("step_ab", "b_over_a_step", stat="median", **kw)
+                if r is None:
+                    continue
+                rm = R.value("step_ab", "b_over_a_step_min", stat="median", **kw)
+                a, b = (R.value("step_ab", f"ns{x}_step", stat="min", **kw) for x in "AB")
+                pa, pb = (R.value("step_ab", f"ns{x}_{stage}", stat="min", **kw) for x in "AB")
+                rows.append([f"`{scene}`: {label}", str(t), f"{r:.3f} [{rm:.3f}]",
+                             f"{fmt(a)} → {fmt(b)}", f"{fmt(pa, 2)} → {fmt(pb, 2)}"])
+        if not rows:
+            continue
+        out += ["", f"### {heading}", "",
+                f"`step_ab/scene:.../b:{b_label}`: two simulations of the scene, {what}, "
+                "alternate blocks of 4 steps (A,B / B,A / ...; one untimed step opens each "
+                f"block). Ratio: median over the pairs of t(B) / t(A) (> 1: {faster}), [ratio "
+                f"of the minima]; ns/particle/step, minima, A → B; the {stage} column is the "
+                "stage (with the fused tail, its measured share of the fused pass).", "",
+                table(["scene", "threads", "B / A", "step A → B", f"{stage} A → B"], rows)]
+    return out
 
 
 def paired_speedup_table(R):
