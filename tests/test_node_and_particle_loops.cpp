@@ -126,6 +126,39 @@ void by_material_matches_per_material() {
   expect_close(a.V, b.V, "volume");
 }
 
+// A range of one material takes IsotropicByMaterial's scalar-constant
+// path, a mixed one the looked-up loop: the same particle must get the same
+// bits either way. Materials in blocks (0, then 1, then mixed), updated
+// once as one mixed range and once block by block. Bitwise.
+template <int D>
+void uniform_ranges_match_the_looked_up_loop() {
+  const std::size_t n = 1501, first_block = 500, second_block = 1100;
+  Particles<D> whole(n, 3, 17), blocks(n, 3, 17);
+  for (Particles<D>* q : {&whole, &blocks})
+    for (std::size_t p = 0; p < second_block; ++p) q->mat[p] = p < first_block ? 0 : 1;
+  IsotropicByMaterial<D, double> table;
+  table.dt = 1e-4;
+  for (int i = 0; i < 3; ++i) {
+    const ElasticKernelConstants k = isotropic(1000.0 * (i + 1), 0.2 + 0.1 * i, false);
+    table.lam[std::size_t(i)] = k.lambda;
+    table.mu2[std::size_t(i)] = 2 * k.mu;
+  }
+  table.range(whole.P, 0, n);
+  table.range(blocks.P, 0, first_block);
+  table.range(blocks.P, first_block, second_block);
+  table.range(blocks.P, second_block, n);
+  table.range(blocks.P, 7, 7);  // empty: nothing to do
+  for (int c = 0; c < kStressComponents<D>; ++c)
+    ASSERT_EQ(std::memcmp(blocks.s[c].data(), whole.s[c].data(), n * sizeof(double)), 0)
+        << "stress " << c;
+  ASSERT_EQ(std::memcmp(blocks.V.data(), whole.V.data(), n * sizeof(double)), 0) << "volume";
+}
+
+TEST(ConstitutiveLoops, OneMaterialRangesMatchTheLookedUpLoop) {
+  uniform_ranges_match_the_looked_up_loop<2>();
+  uniform_ranges_match_the_looked_up_loop<3>();
+}
+
 TEST(ConstitutiveLoops, IsotropicByMaterialMatchesPerMaterialUpdates2D) {
   by_material_matches_per_material<2>();
 }
