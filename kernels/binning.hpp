@@ -268,7 +268,6 @@ struct PositionTile {
     for (int d = 0; d < D; ++d) k.x[std::size_t(d)] = positions[d];
     return k;
   }
-  std::uint32_t tile_of_key(std::uint32_t k) const { return tiles.tile_of_key(k); }
   // Whether any particle of [begin, end) is outside the tile of its key: the
   // test of slot(tile(p)) != slot_of_key(key[p]) for a whole range, as one loop the
   // compiler vectorises. Asked per particle inside G2P, this test was a fifth

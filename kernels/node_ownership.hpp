@@ -16,9 +16,10 @@
 // tiles where each thread's particles begin (each color's tiles are split
 // among the threads in tile order, x fastest like the nodes), so thread i
 // owns, in every field, the nodes of the rows its tiles cover, up to the
-// bands the threads share, where the cut balances the node counts. Which thread runs a node never
-// changes what the node computes, and the reductions below keep their
-// fixed chunks, so results do not depend on the split or the thread count.
+// bands the threads share, where the cut balances the node counts. Which
+// thread runs a node never changes what the node computes, and the
+// reductions below keep their fixed chunks, so results do not depend on
+// the split or the thread count.
 #pragma once
 
 #include <omp.h>
