@@ -35,6 +35,10 @@ struct PairParams {
   // When the pass treats the other field as `a`, those normals are negated (n runs a → b).
   int first_field = -1;
   Separation separation = Separation::displacement;
+  // δ_con / h⊥ of the position method (P-14): the extrapolated separation of
+  // two surfaces that touch. The paper's 0.8; a smaller value registers
+  // contact later (docs/contact_validation.md §4.3).
+  Real contact_offset = Real(0.8);
   Real omega_min = 0;  // ABSOLUTE nodal domain below which the node is skipped (units of grid.vol)
   bool force_limit = true;  // §4.4 (explicit integration only)
   Integration integration = Integration::explicit_;

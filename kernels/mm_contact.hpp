@@ -36,10 +36,11 @@ inline bool in_contact(Real dp_dot_n, Real corrected_normal_separation) {
 }
 
 // δ_n' (P-14): the displacement method uses δ_n; the position method subtracts the
-// contact offset δ_con = 0.8 h⊥ of two surfaces exactly in contact.
+// contact offset δ_con = offset · h⊥ of two surfaces exactly in contact (the
+// paper's offset: 0.8).
 template <class Real>
-inline Real corrected_normal_separation(Separation method, Real delta_n, Real h_perp) {
-  return method == Separation::position ? delta_n - Real(0.8) * h_perp : delta_n;
+inline Real corrected_normal_separation(Separation method, Real delta_n, Real h_perp, Real offset) {
+  return method == Separation::position ? delta_n - offset * h_perp : delta_n;
 }
 
 // Momentum change of a for a pair in contact (ALGORITHM §3.1). `dp` is Δp_a, `n` the

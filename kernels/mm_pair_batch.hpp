@@ -187,6 +187,7 @@ template <NormalMethod M, Law L, bool UseDf, int D, class Real>
   const PairParams<Real>& pp = *B.params;
   const Real omega_min = pp.omega_min, friction = pp.friction;
   const bool position_method = pp.separation == Separation::position;
+  const Real contact_offset = pp.contact_offset;
   const bool bilinear = pp.traction_law == TractionLaw::bilinear;
   const bool force_limit = pp.force_limit;
   const Real Dn = pp.Dn, Dn_compression = pp.Dn_compression, Dt_stiffness = pp.Dt;
@@ -252,7 +253,7 @@ template <NormalMethod M, Law L, bool UseDf, int D, class Real>
       for (int d = 0; d < D; ++d) t[d] = delta_t > 0 ? opening_t[d] * inv_len : perpendicular[d];
     }
     const Real hp = h_perp<D, Real>(n, t, h);
-    const Real dn = position_method ? delta_n - Real(0.8) * hp : delta_n;
+    const Real dn = position_method ? delta_n - contact_offset * hp : delta_n;
     for (int d = 0; d < D; ++d) B.n[d][i] = valid ? n[d] : Real(0);
     B.dn[i] = valid ? dn : Real(0);
     const Real dp_n = dot<D, Real>(dp, n);

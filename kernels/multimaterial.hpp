@@ -372,7 +372,8 @@ InteractionResult<D, Real> interact_pass_a(const MaterialSide<D, Real>& a,
     if (save) *save = SavedGeometry<D, Real>{};
     return r;
   }
-  const Real dn = corrected_normal_separation(pp.separation, G.delta_n, G.h_perp);
+  const Real dn =
+      corrected_normal_separation(pp.separation, G.delta_n, G.h_perp, pp.contact_offset);
   if (save) *save = SavedGeometry<D, Real>{G.n, dn};
   if (pp.law != Law::interface) return contact_result<D, Real>(G, pp, dn);
 
@@ -413,8 +414,8 @@ InteractionResult<D, Real> interact_pass_b(const MaterialSide<D, Real>& a,
       screened_geometry<D, Real>(a, b, b_is_rigid, pp, sign, node_position, h);
   if (!G.valid) return r;
   if (pp.law != Law::interface)
-    return contact_result<D, Real>(G, pp,
-                                   corrected_normal_separation(pp.separation, G.delta_n, G.h_perp));
+    return contact_result<D, Real>(
+        G, pp, corrected_normal_separation(pp.separation, G.delta_n, G.h_perp, pp.contact_offset));
   r.evaluated = true;
   r.momentum_change = directional_stick_change<D, Real>(stick_flags, G.dp, G.n);
   return r;

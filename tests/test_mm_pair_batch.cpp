@@ -146,6 +146,7 @@ void check_two_fields() {
         pp.normal_vector = {Real(0.6), Real(-0.8), Real(0)};
         pp.radial_center = {Real(3), Real(4), Real(2)};
         pp.separation = variant & 1 ? Separation::position : Separation::displacement;
+        pp.contact_offset = Real(0.65);  // not the default: the batch must read it
         pp.omega_min = variant & 2 ? Real(0.4) : Real(0);  // screens some nodes
         pp.force_limit = (variant & 4) == 0;
         pp.traction_law = variant & 8 ? TractionLaw::bilinear : TractionLaw::linear;

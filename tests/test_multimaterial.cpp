@@ -176,21 +176,24 @@ TEST(MultimaterialContact, DisplacementMethodNeedsClosedGap) {
 }
 
 TEST(MultimaterialContact, PositionMethodSubtractsContactOffset) {
-  // Position method: δ_n' = δ_n − 0.8 h⊥ with h⊥ = 2 (cell 2 × 2): contact iff δ_n < 1.6.
-  for (const double gap : {1.5, 1.7}) {
-    TestGrid<2, double> grid({1, 1, 1}, 2, {2, 2, 1});
-    grid.set(0, 0, 2.0, {1, 0, 0}, {10.0, 3.0, 0}, 0.5);
-    grid.set(1, 0, 3.0, {-1, 0.5, 0}, {10.0 + gap, 3.0, 0}, 0.5);
-    TestSetup<2, double> setup(2);
-    auto pp = contact_params<double>(Law::stick);
-    pp.separation = Separation::position;
-    setup.connect(0, 1, pp);
-    MMStats stats;
-    std::vector<unsigned char> flags;
-    run_pass_a(grid, setup, stats, flags);
-    const double expected = gap < 1.6 ? -0.2 : 1.0;
-    EXPECT_NEAR(grid.velocity(0, 0, 0), expected, kTol) << "gap " << gap;
-  }
+  // Position method: δ_n' = δ_n − offset · h⊥ with h⊥ = 2 (cell 2 × 2): contact
+  // iff δ_n < 2 · offset (1.6 with the paper's 0.8, 1.2 with 0.6).
+  for (const double offset : {0.8, 0.6})
+    for (const double gap : {1.1, 1.3, 1.5, 1.7}) {
+      TestGrid<2, double> grid({1, 1, 1}, 2, {2, 2, 1});
+      grid.set(0, 0, 2.0, {1, 0, 0}, {10.0, 3.0, 0}, 0.5);
+      grid.set(1, 0, 3.0, {-1, 0.5, 0}, {10.0 + gap, 3.0, 0}, 0.5);
+      TestSetup<2, double> setup(2);
+      auto pp = contact_params<double>(Law::stick);
+      pp.separation = Separation::position;
+      pp.contact_offset = offset;
+      setup.connect(0, 1, pp);
+      MMStats stats;
+      std::vector<unsigned char> flags;
+      run_pass_a(grid, setup, stats, flags);
+      const double expected = gap < 2 * offset ? -0.2 : 1.0;
+      EXPECT_NEAR(grid.velocity(0, 0, 0), expected, kTol) << "offset " << offset << ", gap " << gap;
+    }
 }
 
 TEST(MultimaterialContact, VolumeScreeningSkipsSmallNodes) {

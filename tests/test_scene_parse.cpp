@@ -225,6 +225,7 @@ Dn_compression = 1e6
 normal = "specified"
 normal_vector = [2.0, 0.0]
 separation = "position"
+contact_offset = 0.6
 min_volume = 0.75
 force_limit = false
 integration = "exact"
@@ -449,6 +450,7 @@ TEST(SceneParseValid, Full2DSceneInteractions) {
   EXPECT_EQ(in.normal, NormalMethod::specified);
   expect_vec(in.normal_vector, 1.0, 0.0, 0.0);
   EXPECT_EQ(in.separation, Separation::position);
+  EXPECT_DOUBLE_EQ(in.contact_offset, 0.6);
   EXPECT_DOUBLE_EQ(in.min_volume, 0.75);
   EXPECT_FALSE(in.force_limit);
   EXPECT_EQ(in.integration, Integration::exact);
@@ -564,6 +566,7 @@ TEST(SceneParseValid, DefaultsAreFilled) {
   EXPECT_TRUE(std::isinf(in.Dn_compression));
   EXPECT_EQ(in.normal, NormalMethod::mvg);
   EXPECT_EQ(in.separation, Separation::displacement);
+  EXPECT_DOUBLE_EQ(in.contact_offset, 0.8);
   EXPECT_DOUBLE_EQ(in.min_volume, 0.0);
   EXPECT_TRUE(in.force_limit);
   EXPECT_EQ(in.integration, Integration::explicit_);
@@ -903,6 +906,15 @@ TEST(SceneParseErrors, InteractionValues) {
   inter("friction = -0.1", "interaction[0].friction", {"expected a number >= 0, got -0.1"});
   inter("min_volume = 1.0", "interaction[0].min_volume", {"[0, 1)", "got 1"});
   inter("min_volume = -0.2", "interaction[0].min_volume", {"[0, 1)"});
+  inter("contact_offset = 0.5", "interaction[0].contact_offset",
+        {"applies to separation = \"position\" only"});
+  for (const char* bad : {"0.0", "2.5"}) {  // the key's line: one below separation
+    const Mutation m =
+        mutate(kBase, "Dt = 5.0\n",
+               std::string("Dt = 5.0\nseparation = \"position\"\ncontact_offset = ") + bad + "\n");
+    expect_error(m.text, m.line + 2, "interaction[0].contact_offset",
+                 {"(0, 2]", std::string("got ") + (bad[0] == '0' ? "0" : "2.5")});
+  }
   inter("normal = \"rigid\"", "interaction[0].normal",
         {"needs one of the two materials to be rigid"});
   inter("Dn_compression = -3", "interaction[0].Dn_compression", {">= 0"});

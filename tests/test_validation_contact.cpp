@@ -403,13 +403,42 @@ TEST(ValidationContact, DiskRollsWithoutSlipping) {
 TEST(ValidationContact, DiskSlidesWhenFrictionIsLow) {
   MMPM_KNOWN_LIMITATION(
       "the sliding disk's spin-up is 51 % of mu m g cos(theta) R / I with MUSL "
-      "(linear acceleration within 1 %); cause not isolated");
+      "(linear acceleration within 1 %): nodes ahead of the contact point count as "
+      "in contact under the paper's offset 0.8 h and push up there "
+      "(docs/contact_validation.md §4.3; DiskSpinUpFollowsTheContactOffset)");
   const InclineRun r = run_incline("incline_disk.toml", {"interaction[0].friction=0.05"});
   EXPECT_NEAR(r.accel / sliding_accel(r), 1.0, 0.05)
       << "a = " << r.accel << ", exact " << sliding_accel(r);
   const double alpha = -2.0 * r.mu * r.G * std::cos(r.theta) / r.radius;
   EXPECT_NEAR(r.spin_accel / alpha, 1.0, 0.10) << "alpha = " << r.spin_accel << ", exact " << alpha;
   EXPECT_LT(std::abs(r.spin_accel) * r.radius, 0.5 * r.accel) << "it must slip";
+}
+
+// Why the sliding disk spins up too slowly (docs/contact_validation.md §4.3):
+// with the paper's contact offset 0.8 h the nodes up to ~1 mm ahead of the
+// contact point, where the disk is still 0-0.13 mm above the floor, count
+// as in contact; the normal force they take sits ahead of the centre and
+// its torque cancels about half of the friction torque. A smaller offset
+// registers contact only nearer the contact point: at 0.6 h the spin-up is
+// within 10 % of the exact value, and the disk sinks deeper (the price).
+// h = 0.5 mm, mu = 0.05, the fit window of DiskSlidesWhenFrictionIsLow.
+TEST(ValidationContact, DiskSpinUpFollowsTheContactOffset) {
+  double spin[2] = {0, 0}, sink[2] = {0, 0};
+  const double offsets[2] = {0.8, 0.6};
+  for (int k = 0; k < 2; ++k) {
+    const InclineRun r = run_incline(
+        "incline_disk.toml",
+        {"interaction[0].friction=0.05", "interaction[0].contact_offset=" + num(offsets[k])});
+    const double alpha = -2.0 * r.mu * r.G * std::cos(r.theta) / r.radius;
+    spin[k] = r.spin_accel / alpha;
+    sink[k] = r.sink;
+    note("contact_offset %.1f: spin-up %.3f of exact, a %.3f (exact %.3f), sink %.4f mm",
+         offsets[k], spin[k], r.accel, sliding_accel(r), r.sink);
+    EXPECT_NEAR(r.accel / sliding_accel(r), 1.0, 0.05) << "offset " << offsets[k];
+  }
+  EXPECT_NEAR(spin[1], 1.0, 0.10) << "spin-up with the offset 0.6 h";
+  EXPECT_GT(spin[1] - spin[0], 0.3) << "the offset must be what holds the spin back";
+  EXPECT_GT(sink[1], sink[0] + 0.1) << "a later contact lets the disk sink deeper";
 }
 
 // ---------------------------------------------------------------------------

@@ -235,6 +235,8 @@ void write_interaction(Writer& w, const InteractionSpec& in) {
   w.vec("center", in.center);
   w.word("separation", in.separation);
   w.num("min_volume", in.min_volume);
+  // Read only with the position method (parse.cpp rejects it otherwise).
+  if (in.separation == Separation::position) w.num("contact_offset", in.contact_offset);
   w.boolean("force_limit", in.force_limit);
   w.word("integration", in.integration);
 }

@@ -933,7 +933,8 @@ class SceneReader {
   // ------------------------------------------------------- [[interaction]]
   void add_interaction(const Table& t) {
     t.only({"materials", "law", "friction", "Dn", "Dt", "traction_law", "Dn_compression", "normal",
-            "normal_vector", "center", "separation", "min_volume", "force_limit", "integration"});
+            "normal_vector", "center", "separation", "contact_offset", "min_volume", "force_limit",
+            "integration"});
     InteractionSpec in;
     in.where = t.where();
     const Field mats = t.need("materials");
@@ -949,6 +950,15 @@ class SceneReader {
     if (auto f = t.get("Dn_compression")) in.Dn_compression = stiffness(*f);
     read_normal(t, in, *pair.first, *pair.second);
     if (auto f = t.get("separation")) in.separation = f->choice(kSeparationNames);
+    if (auto f = t.get("contact_offset")) {
+      if (in.separation != Separation::position)
+        f->fail("contact_offset applies to separation = \"position\" only");
+      in.contact_offset = f->number();
+      if (!(in.contact_offset > 0 && in.contact_offset <= 2)) {
+        f->fail("expected a fraction of the cell size in (0, 2], got " +
+                format_number(in.contact_offset));
+      }
+    }
     if (auto f = t.get("min_volume")) {
       in.min_volume = f->number();
       if (in.min_volume < 0 || in.min_volume >= 1) {

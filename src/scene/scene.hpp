@@ -134,7 +134,8 @@ struct InteractionSpec {
   Vec3 normal_vector{1, 0, 0};
   Vec3 center{0, 0, 0};  // radial
   Separation separation = Separation::displacement;
-  double min_volume = 0.0;  // fraction of the cell volume
+  double min_volume = 0.0;      // fraction of the cell volume
+  double contact_offset = 0.8;  // δ_con / h⊥, position separation only (P-14)
   bool force_limit = true;
   Integration integration = Integration::explicit_;
   Where where;

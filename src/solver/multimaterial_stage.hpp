@@ -44,6 +44,7 @@ class MultimaterialStage {
       for (std::size_t m = 0; m < scene.materials.size(); ++m)
         if (scene.materials[m].name == it.materials[0]) pp.first_field = plan.field_of_material[m];
       pp.separation = it.separation;
+      pp.contact_offset = Real(it.contact_offset);
       pp.omega_min = Real(it.min_volume * cell);
       pp.force_limit = it.force_limit;
       pp.integration = it.integration;

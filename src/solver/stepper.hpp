@@ -168,7 +168,8 @@ class Stepper final : public Simulation {
   GridView<D, Real> G_;
   GridVelocity<D, Real> GV_;
   std::vector<Real> scratch_;
-  std::array<std::vector<Real>, D> x_next_;  // MUSL's end-of-step positions
+  // MUSL's end-of-step positions, staggered like the particle columns (4 KiB aliasing)
+  std::array<StaggeredArray<Real>, D> x_next_;
   std::vector<std::uint32_t> perm_, offsets_, scratch_keys_;
 
   TileLayout<D> tiles_;

@@ -797,7 +797,7 @@ void Stepper<D, Shape, Real>::step() {
     // Both use the step's starting positions (Sulsky's MUSL).
     tic();
     for (int d = 0; d < D; ++d) {
-      x_next_[d].resize(P_.n);
+      if (x_next_[d].size() != P_.n) x_next_[d].allocate(P_.n, pcols_.next_slot++);
       P_.x_next[d] = x_next_[d].data();
     }
     std::array<Real*, D> momenta;
