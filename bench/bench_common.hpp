@@ -33,6 +33,7 @@
 #include "kernels/shape.hpp"
 #include "kernels/weights.hpp"
 #include "model/staggered_array.hpp"
+#include "solver/storage.hpp"
 
 namespace mmpm {
 class Simulation;
@@ -353,14 +354,7 @@ struct Binning {
     schedule.build(tiles, S.P.key, S.P.n);
   }
   void permute_columns(ParticleSet<D, Real>& S) {
-    const std::size_t n = S.P.n;
-    permute_in_place(S.id.data(), scratch_keys.data(), perm.data(), n, &schedule);
-    scratch.resize(n);
-    for (auto& col : S.reals)
-      permute_in_place(col.data(), scratch.data(), perm.data(), n, &schedule);
-    scratch_bytes.resize(n);
-    for (auto& col : S.bytes)
-      permute_in_place(col.data(), scratch_bytes.data(), perm.data(), n, &schedule);
+    permute_particle_columns(S, perm.data(), S.P.n, schedule, scratch_keys, scratch, scratch_bytes);
   }
   void sort(ParticleSet<D, Real>& S, const GridView<D, Real>& G) {
     compute_keys(S, G);

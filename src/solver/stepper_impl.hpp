@@ -213,13 +213,8 @@ void Stepper<D, Shape, Real>::sort_particles() {
   scratch_keys_.resize(n);
   permute_in_place(P_.key, scratch_keys_.data(), perm_.data(), n);
   schedule_.build(tiles_, P_.key, n);
-  permute_in_place(pcols_.id.data(), scratch_keys_.data(), perm_.data(), n, &schedule_);
-  scratch_.resize(n);
-  for (auto& col : pcols_.reals)
-    permute_in_place(col.data(), scratch_.data(), perm_.data(), n, &schedule_);
-  scratch_bytes_.resize(n);
-  for (auto& col : pcols_.bytes)
-    permute_in_place(col.data(), scratch_bytes_.data(), perm_.data(), n, &schedule_);
+  permute_particle_columns(pcols_, perm_.data(), n, schedule_, scratch_keys_, scratch_,
+                           scratch_bytes_);
   schedule_built();
   dirty_ = false;
   grid_ready_ = false;  // a P2G in the old order

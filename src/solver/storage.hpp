@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "kernels/binning.hpp"
 #include "model/staggered_array.hpp"
 
 namespace mmpm {
@@ -49,5 +50,22 @@ struct ColumnSet {
     return nullptr;
   }
 };
+
+// Every column of a particle store (seed ids, reals, bytes: a ColumnSet or
+// the benchmarks' ParticleSet) into the order `perm` gives, after the keys.
+// Each thread writes back the rows its loops take in the new order
+// (`sorted`, permute_in_place). The scratch vectors grow to n.
+template <class Columns, class Real>
+void permute_particle_columns(Columns& c, const std::uint32_t* perm, std::size_t n,
+                              const TileSchedule& sorted, std::vector<std::uint32_t>& scratch_ids,
+                              std::vector<Real>& scratch_reals,
+                              std::vector<std::uint8_t>& scratch_bytes) {
+  scratch_ids.resize(n);
+  permute_in_place(c.id.data(), scratch_ids.data(), perm, n, &sorted);
+  scratch_reals.resize(n);
+  for (auto& col : c.reals) permute_in_place(col.data(), scratch_reals.data(), perm, n, &sorted);
+  scratch_bytes.resize(n);
+  for (auto& col : c.bytes) permute_in_place(col.data(), scratch_bytes.data(), perm, n, &sorted);
+}
 
 }  // namespace mmpm
