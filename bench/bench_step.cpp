@@ -5,6 +5,8 @@
 //                     [[interaction]] interface, Dn perfect, Dt 5, specified
 //                     normal [1,0], 250 000 particles (the paper's two-layer)
 //   3d_gimp_1mat      3D gimp, one elastic material, 101 376 particles
+//   2d_linear_room    2d_linear_1mat's block in a grid of 504 x 504 cells
+//                     (step_ab only: node passes over empty nodes)
 //   2d_gimp_inclusions 2D gimp, 625 glass disks in a polymer block, interface
 //                     (inclusions_scene); with mm_fields_share = 1 (fields
 //                     always apart), and the two-layer scene with 0 (always
@@ -274,6 +276,9 @@ StepCase shared_case(const std::string& scene) {
   if (scene == "3d_gimp_1mat") return {scene, kGimp3D, {}};
   if (scene == "2d_gimp_interface") return {scene, two_layer(true, true), {}};
   if (scene == "2d_gimp_inclusions") return {scene, inclusions_scene(), {}};
+  // The 2D linear block in a grid twice as wide and tall: three quarters
+  // of the nodes are empty, as around a body with room to move.
+  if (scene == "2d_linear_room") return {scene, linear_block_scene(250), {"grid.cells=[504, 504]"}};
   throw std::invalid_argument("no whole-step scene named " + scene);
 }
 
@@ -312,7 +317,7 @@ Simulation& step_scene_simulation(const std::string& scene) {
 Simulation& step_scene_simulation(const std::string& scene,
                                   const std::vector<std::string>& overrides) {
   StepCase c = shared_case(scene);
-  c.overrides = overrides;
+  c.overrides.insert(c.overrides.end(), overrides.begin(), overrides.end());
   return simulation_for(c);
 }
 

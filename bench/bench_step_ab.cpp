@@ -63,14 +63,19 @@ void bm_step_ab(benchmark::State& state, const std::string& scene, const std::st
 void register_step_ab() {
   // B: one setting away from the defaults (A). fuse_step_tail: MUSL's step
   // tail as three separate passes; particle_order: particles stored in
-  // plain tile order instead of color by color.
+  // plain tile order instead of color by color; skip_empty_nodes: the node
+  // passes over every node of every field.
   const std::pair<const char*, const char*> settings[] = {
       {"fuse_step_tail_false", "simulation.fuse_step_tail=false"},
-      {"particle_order_tile", "simulation.particle_order=\"tile\""}};
+      {"particle_order_tile", "simulation.particle_order=\"tile\""},
+      {"skip_empty_nodes_false", "simulation.skip_empty_nodes=false"}};
   for (const auto& [label, override_b] : settings)
-    for (const char* scene :
-         {"2d_linear_1mat", "2d_gimp_interface", "2d_gimp_inclusions", "3d_gimp_1mat"})
+    for (const char* scene : {"2d_linear_1mat", "2d_gimp_interface", "2d_gimp_inclusions",
+                              "3d_gimp_1mat", "2d_linear_room"})
       for (int threads : {1, 2}) {
+        // The roomy grid only for the setting it is there for.
+        const bool room = std::string(scene) == "2d_linear_room";
+        if (room && std::string(label) != "skip_empty_nodes_false") continue;
         const std::string name = std::string("step_ab/scene:") + scene + "/b:" + label +
                                  "/threads:" + std::to_string(threads);
         const std::string b = override_b;

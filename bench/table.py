@@ -352,6 +352,7 @@ STEP_SCENES = [
     ("3d_gimp_1mat", "3D gimp, 1 elastic material"),
     ("2d_gimp_1mat", "2D gimp, same geometry, 1 material (baseline)"),
     ("2d_gimp_2mat_shared", "2D gimp, 2 materials sharing one field"),
+    ("2d_linear_room", "2D linear block in a 504 × 504 grid, 3/4 of the nodes empty (step_ab only)"),
 ]
 
 
@@ -416,6 +417,10 @@ PAIRED_SETTINGS = [
      "(B: particle_order = \"tile\")",
      "A with the defaults (particles stored color by color, so each colored pass reads them "
      "front to back) and B stored in plain tile order", "color order is faster", "g2p"),
+    ("skip_empty_nodes_false", "Node passes over the reachable nodes, paired blocks "
+     "(B: skip_empty_nodes = false)",
+     "A with the defaults (zeroing, momentum update, velocities over the nodes each field's "
+     "particles can reach) and B over every node of every field", "skipping is faster", "grid"),
 ]
 
 

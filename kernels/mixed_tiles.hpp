@@ -26,24 +26,18 @@
 #include <vector>
 
 #include "kernels/binning.hpp"
+#include "kernels/tile_spans.hpp"
 
 namespace mmpm {
 
 template <int D>
 struct MixedTiles {
-  TileLayout<D> layout;
-  std::array<int, 3> nodes_per_dim{1, 1, 1};
-  // Per tile row r = ty + tiles_y tz: the node intervals [x0, x1) along x
-  // of its runs of mixed tiles, spans[span_begin[r] .. span_begin[r + 1]).
-  std::vector<std::uint32_t> span_begin;
-  std::vector<std::array<std::uint32_t, 2>> spans;
+  TileSpans<D> tiles;  // the mixed tiles' nodes
 
   // From the tile ranges of the sorted particles (TileSchedule::begin, by
   // slot) and their fields.
-  void build(const TileLayout<D>& tiles, const std::array<int, 3>& nodes,
+  void build(const TileLayout<D>& layout, const std::array<int, 3>& nodes,
              const std::vector<std::uint32_t>& begin, const std::uint8_t* field) {
-    layout = tiles;
-    nodes_per_dim = nodes;
     const std::size_t nt = layout.tile_count;
     // Per tile: kEmpty, kSeveral, or the one field its particles have.
     constexpr int kEmpty = -1, kSeveral = -2;
@@ -79,67 +73,18 @@ struct MixedTiles {
               }
           mixed[layout.tile_index(tx, ty, tz)] = two;
         }
-    span_begin.assign(std::size_t(n[1]) * std::size_t(n[2]) + 1, 0);
-    spans.clear();
-    const auto nx = std::uint32_t(nodes_per_dim[0]);
-    for (int tz = 0; tz < n[2]; ++tz)
-      for (int ty = 0; ty < n[1]; ++ty) {
-        for (int tx = 0; tx < n[0]; ++tx) {
-          if (!mixed[layout.tile_index(tx, ty, tz)]) continue;
-          const auto x0 = std::uint32_t(tx) << layout.shift;
-          const std::uint32_t x1 = tx + 1 == n[0] ? nx : std::uint32_t(tx + 1) << layout.shift;
-          const bool extends =
-              spans.size() > span_begin[std::size_t(ty + n[1] * tz)] && spans.back()[1] == x0;
-          if (extends)
-            spans.back()[1] = x1;
-          else
-            spans.push_back({x0, x1});
-        }
-        span_begin[std::size_t(ty + n[1] * tz) + 1] = std::uint32_t(spans.size());
-      }
+    tiles.build(layout, nodes, mixed);
   }
 
   // body(first, count) for each maximal run of nodes in [first, first +
   // count) (flat node indices of one field, x fastest) whose tile is mixed.
   template <class Body>
   void for_each_mixed_run(std::size_t first, std::size_t count, Body&& body) const {
-    const auto nx = std::size_t(nodes_per_dim[0]), ny = std::size_t(nodes_per_dim[1]);
-    const std::size_t end = first + count;
-    std::size_t run = end, run_end = end;  // the open run [run, run_end), run == end: none
-    std::size_t row = first / nx, y = row % ny, z = row / ny;
-    for (std::size_t row_start = row * nx; row_start < end; row_start += nx) {
-      const std::size_t r =
-          std::size_t(tile_along(1, y)) +
-          std::size_t(layout.tiles[1]) * std::size_t(D == 3 ? tile_along(2, z) : 0);
-      for (std::uint32_t k = span_begin[r]; k < span_begin[r + 1]; ++k) {
-        const std::size_t a = std::max(first, row_start + spans[k][0]);
-        const std::size_t b = std::min(end, row_start + spans[k][1]);
-        if (a >= b) continue;
-        if (run != end && run_end == a) {
-          run_end = b;  // continues the open run (across a row end too)
-        } else {
-          if (run != end) body(run, run_end - run);
-          run = a, run_end = b;
-        }
-      }
-      if (++y == ny) y = 0, ++z;
-    }
-    if (run != end) body(run, run_end - run);
+    tiles.for_each_run(first, count, body);
   }
 
   // Nodes of the mixed tiles (each node counted in the tile that holds it).
-  std::size_t mixed_node_count() const {
-    std::size_t nodes = 1;
-    for (int d = 0; d < D; ++d) nodes *= std::size_t(nodes_per_dim[std::size_t(d)]);
-    std::size_t c = 0;
-    for_each_mixed_run(0, nodes, [&](std::size_t, std::size_t k) { c += k; });
-    return c;
-  }
-
- private:
-  int tile_along(int d, std::size_t node) const {
-    return std::min(int(node >> layout.shift), layout.tiles[std::size_t(d)] - 1);
-  }
+  std::size_t mixed_node_count() const { return tiles.node_count(); }
 };
 
 }  // namespace mmpm

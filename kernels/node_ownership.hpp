@@ -31,6 +31,7 @@
 #include <utility>
 #include <vector>
 
+#include "kernels/active_nodes.hpp"
 #include "kernels/binning.hpp"
 #include "kernels/reduce.hpp"
 
@@ -40,6 +41,10 @@ struct NodeOwnership {
   // threads + 1 ascending node indices, split[0] = 0, split[threads] = nodes;
   // empty: an even split.
   std::vector<std::size_t> split;
+  // With runs: the loops below visit only the nodes each field's particles
+  // can reach (kernels/active_nodes.hpp); the nodes outside hold zeros.
+  // Null: every node.
+  const FieldNodeRuns* active = nullptr;
 
   // Nodes [first, last) of thread i of `threads`. A team of another size
   // than the split was made for (a loop below its parallel threshold runs
@@ -74,10 +79,14 @@ struct NodeOwnership {
 // split nodes i / threads. Why not the tile's lowest node (the cut before):
 // with 8-cell tiles in 3D that left thread 0 ~30 % of the nodes of a block
 // filling its grid, and every node loop waited on the other thread
-// (docs/performance.md "A cut balanced inside the band").
+// (docs/performance.md "A cut balanced inside the band"). With `active`
+// (kernels/active_nodes.hpp) the even split counts only the nodes the
+// loops visit: around a body in a large grid, half the grid's nodes may
+// sit above it, all in one thread's share.
 template <int D>
 NodeOwnership node_ownership(const TileLayout<D>& layout, const std::array<int, 3>& nodes_per_dim,
-                             const TileSchedule& schedule, std::size_t threads) {
+                             const TileSchedule& schedule, std::size_t threads,
+                             const FieldNodeRuns* active = nullptr) {
   NodeOwnership own;
   std::size_t nodes = 1;
   for (int d = 0; d < D; ++d) nodes *= std::size_t(nodes_per_dim[std::size_t(d)]);
@@ -100,7 +109,8 @@ NodeOwnership node_ownership(const TileLayout<D>& layout, const std::array<int, 
     }
     const std::size_t band_lo = std::min(first, top_nodes) * slice;
     const std::size_t band_hi = std::min(last, top_nodes) * slice;
-    const std::size_t even = nodes * i / threads;
+    const std::size_t even =
+        active ? active->node_quantile(nodes, i, threads) : nodes * i / threads;
     own.split[i] = std::clamp(std::clamp(even, band_lo, band_hi), own.split[i - 1], nodes);
   }
   own.split[threads] = nodes;
@@ -114,7 +124,13 @@ inline void for_own_field_nodes(const NodeOwnership& own, std::size_t nodes, int
                                 Body&& body) {
   const auto [b, e] = own.mine(nodes);
   if (b >= e) return;
-  for (int f = 0; f < fields; ++f) body(f, b, e);
+  for (int f = 0; f < fields; ++f) {
+    if (own.active)
+      own.active->for_each(f, b, e,
+                           [&](std::size_t first, std::size_t last) { body(f, first, last); });
+    else
+      body(f, b, e);
+  }
 }
 
 // As for_own_field_nodes, with flat (field, node) indices: body(first, last).
@@ -158,7 +174,14 @@ std::vector<std::array<double, K>> owned_field_sums(const NodeOwnership& own, st
     for (int f = 0; f < fields; ++f)
       for (std::size_t c = c0; c < c1; ++c) {
         std::array<double, K> acc{};
-        body(f, c * kReduceChunk, std::min(nodes, (c + 1) * kReduceChunk), acc);
+        const std::size_t b = c * kReduceChunk, e = std::min(nodes, (c + 1) * kReduceChunk);
+        // A chunk's runs in node order: the skipped nodes would have added
+        // +0 (zero mass), so the chunk's sum keeps its bits.
+        if (own.active)
+          own.active->for_each(
+              f, b, e, [&](std::size_t first, std::size_t last) { body(f, first, last, acc); });
+        else
+          body(f, b, e, acc);
         partial[std::size_t(f) * chunks + c] = acc;
       }
   }

@@ -29,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "bitwise_same.hpp"
 #include "scene/parse.hpp"
 #include "solver/simulation.hpp"
 #include "validation_util.hpp"
@@ -36,31 +37,13 @@
 namespace {
 
 using namespace mmpm;
+using mmpm::testing::expect_bitwise_same;
 
 const std::string kInputs = std::string(MMPM_SOURCE_DIR) + "/inputs/";
 
 std::vector<std::string> with(std::vector<std::string> sets, bool fuse) {
   sets.push_back(std::string("simulation.fuse_step_tail=") + (fuse ? "true" : "false"));
   return sets;
-}
-
-// Every particle field the solver reports, the energies and the reactions:
-// equal bit for bit.
-void expect_bitwise_same(const Simulation& a, const Simulation& b, const std::string& what) {
-  for (const char* name : {"position", "displacement", "velocity", "stress", "strain", "volume"})
-    EXPECT_EQ(mmpm::testing::differing_values(a, b, name), 0u)
-        << what << " " << name << ": values differing";
-  const Energies e = a.energies(), g = b.energies();
-  EXPECT_EQ(e.kinetic, g.kinetic) << what;
-  EXPECT_EQ(e.strain, g.strain) << what;
-  EXPECT_EQ(e.interface, g.interface) << what;
-  EXPECT_EQ(e.external_work, g.external_work) << what;
-  EXPECT_EQ(e.damping, g.damping) << what;
-  EXPECT_EQ(e.kinetic_unresolved, g.kinetic_unresolved) << what;
-  const auto ra = a.reactions(), rb = b.reactions();
-  ASSERT_EQ(ra.size(), rb.size()) << what;
-  for (std::size_t r = 0; r < ra.size(); ++r)
-    for (int d = 0; d < 3; ++d) EXPECT_EQ(ra[r].force[d], rb[r].force[d]) << what << " " << r;
 }
 
 struct Outcome {

@@ -117,6 +117,7 @@ void write_simulation(Writer& w, const Scene& s) {
   w.integer("sort_every", sim.sort_every);
   w.boolean("fuse_constitutive", sim.fuse_constitutive);
   w.boolean("fuse_step_tail", sim.fuse_step_tail);
+  w.boolean("skip_empty_nodes", sim.skip_empty_nodes);
   w.word("particle_order", sim.particle_order);
   w.boolean("compensated_positions", sim.compensated_positions);
   w.num("mm_fields_share", sim.mm_fields_share);

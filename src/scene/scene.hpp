@@ -65,6 +65,11 @@ struct SimulationSpec {
   // in the cache; same particle results, bitwise (docs/performance.md
   // "The step's tail fused tile by tile"). false: three separate passes.
   bool fuse_step_tail = true;
+  // The node passes (zeroing, momentum update, velocities, supports) visit
+  // only the nodes each velocity field's particles can reach; same results,
+  // bitwise (docs/performance.md "Node passes over the nodes a field can
+  // reach"). false: every node of every field.
+  bool skip_empty_nodes = true;
   // How the particles are stored between sorts: tile by tile, color by color
   // (each colored pass reads its particles front to back), or in plain tile
   // order. Same results but for the order of sums over particles

@@ -13,6 +13,7 @@
 #include <numeric>
 #include <sstream>
 
+#include "kernels/active_nodes.hpp"
 #include "kernels/binning.hpp"
 #include "kernels/constitutive.hpp"
 #include "kernels/g2p.hpp"
@@ -75,6 +76,12 @@ class Stepper final : public Simulation {
   GridView<D, Real>& grid() { return G_; }
   MultimaterialStage<D, Real>& multimaterial() { return mm_; }
   const NodeOwnership& ownership() const { return own_; }
+  // For tests: the shortest gap the node runs skip (kernels/active_nodes.hpp,
+  // kMinSkippedNodes), from the next re-sort on, which this asks for.
+  void set_min_skipped_nodes(std::size_t n) {
+    min_skipped_nodes_ = n;
+    dirty_ = true;
+  }
   const MixedTiles<D>& mixed_tiles() const { return mixed_tiles_; }
 
  private:
@@ -133,6 +140,7 @@ class Stepper final : public Simulation {
   void build_stress_table();
   void grid_update_stage();
   void update_node_ownership(bool rebuilt);
+  void update_active_nodes();
   void finish_velocities(bool with_dvel);
   Supports<Real> supports(bool with_dvel);
   void collect_support_reactions();
@@ -178,6 +186,10 @@ class Stepper final : public Simulation {
   std::size_t own_threads_ = 0;
   ReachTiles reach_tiles_;     // tiles reaching a multimaterial node (p2g_multimaterial)
   MixedTiles<D> mixed_tiles_;  // where multimaterial nodes can be (rebuilt with the tile ranges)
+  // Per field, the nodes its particles can reach (rebuilt with the tile
+  // ranges; [simulation] skip_empty_nodes).
+  FieldNodeRuns active_nodes_;
+  std::size_t min_skipped_nodes_ = kMinSkippedNodes;
   // This step's first P2G also scatters mx, vol, g (chosen from the share of
   // particles the previous step's multimaterial nodes reached).
   bool mm_fields_with_p2g_ = false;

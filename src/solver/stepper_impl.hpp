@@ -304,15 +304,27 @@ void Stepper<D, Shape, Real>::fused_step_tail() {
 template <int D, class Shape, class Real>
 double Stepper<D, Shape, Real>::grid_kinetic_energy() const {
   const std::size_t total = G_.nodes * std::size_t(G_.fields);
-  return deterministic_sum<1>(total,
-                              [&](std::size_t b, std::size_t end, std::array<double, 1>& acc) {
-                                for (std::size_t i = b; i < end; ++i) {
-                                  double v2 = 0;
-                                  for (int d = 0; d < D; ++d)
-                                    v2 += double(GV_.vel[d][i]) * double(GV_.vel[d][i]);
-                                  acc[0] += 0.5 * double(G_.m[i]) * v2;
-                                }
-                              })[0];
+  auto sum = [&](std::size_t b, std::size_t end, std::array<double, 1>& acc) {
+    for (std::size_t i = b; i < end; ++i) {
+      double v2 = 0;
+      for (int d = 0; d < D; ++d) v2 += double(GV_.vel[d][i]) * double(GV_.vel[d][i]);
+      acc[0] += 0.5 * double(G_.m[i]) * v2;
+    }
+  };
+  const FieldNodeRuns* active = own_.active;
+  return deterministic_sum<1>(
+      total, [&](std::size_t b, std::size_t end, std::array<double, 1>& acc) {
+        if (!active) return sum(b, end, acc);
+        // A chunk's runs in node order: the nodes
+        // skipped hold m = 0 and would add +0.
+        for (std::size_t i = b; i < end;) {
+          const std::size_t f = i / G_.nodes, o = f * G_.nodes;
+          const std::size_t last = std::min(end, o + G_.nodes);
+          active->for_each(int(f), i - o, last - o,
+                           [&](std::size_t r0, std::size_t r1) { sum(o + r0, o + r1, acc); });
+          i = last;
+        }
+      })[0];
 }
 
 // Tile ranges, color lists and per-material lists from the (sorted) keys.
@@ -326,6 +338,8 @@ void Stepper<D, Shape, Real>::rebuild_ranges() {
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::schedule_built() {
   const std::size_t n = P_.n;
+  if (scene_.simulation.skip_empty_nodes)
+    update_active_nodes();  // before the split, which counts them
   update_node_ownership(true);
   if (plan_.multimaterial) mixed_tiles_.build(tiles_, G_.nodes_per_dim, schedule_.begin, P_.field);
   if (!material_particles_.empty()) {
@@ -347,9 +361,39 @@ std::pair<std::size_t, std::size_t> Stepper<D, Shape, Real>::color_share(std::si
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::update_node_ownership(bool rebuilt) {
   const auto threads = std::size_t(omp_get_max_threads());
-  if (!rebuilt && own_threads_ == threads) return;
-  own_threads_ = threads;
-  own_ = node_ownership<D>(tiles_, G_.nodes_per_dim, schedule_, threads);
+  if (rebuilt || own_threads_ != threads) {
+    own_threads_ = threads;
+    own_ = node_ownership<D>(tiles_, G_.nodes_per_dim, schedule_, threads,
+                             scene_.simulation.skip_empty_nodes ? &active_nodes_ : nullptr);
+  }
+  // Set at every call, not once, so it follows the Stepper's own member.
+  own_.active = scene_.simulation.skip_empty_nodes ? &active_nodes_ : nullptr;
+}
+
+// The nodes each field's particles can reach, from the new tile ranges
+// (kernels/active_nodes.hpp). The node passes skip the rest, which must
+// hold zeros: every node that leaves a field's runs is zeroed here in every
+// grid array, and stays zero until it rejoins (no particle reaches it, no
+// pass visits it). In a run these nodes are zero already (a particle moves
+// less than a cell per step, so the last P2G reached only nodes of the new
+// runs); the zeroing keeps the invariant whatever the history, and the
+// multimaterial search reads every field's mass at the mixed tiles' nodes
+// (with three fields, nodes outside one field's runs). The support
+// reaction terms are zeroed for the same reason (a skipped support node
+// writes none); the step that follows writes those of the nodes it visits.
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::update_active_nodes() {
+  if (active_nodes_.field.empty()) active_nodes_ = all_node_runs(G_.nodes, G_.fields);
+  FieldNodeRuns next = active_node_runs<D>(tiles_, G_.nodes_per_dim, schedule_.begin, P_.field,
+                                           G_.fields, min_skipped_nodes_);
+  const std::size_t nodes = G_.nodes;
+  for_each_dropped(active_nodes_, next, [&](int f, std::size_t b, std::size_t e) {
+    const std::size_t o = std::size_t(f) * nodes;
+    for (auto& column : gcols_.reals)
+      std::fill(column.data() + o + b, column.data() + o + e, Real(0));
+  });
+  active_nodes_ = std::move(next);
+  for (auto& terms : support_terms_) std::fill(terms.begin(), terms.end(), 0.0);
 }
 
 template <int D, class Shape, class Real>
