@@ -197,15 +197,15 @@ acceleration = [0.0, -200.0]
 
 // Every node where a field has mass lies in that field's runs. Returns the
 // nodes (of all fields) outside the runs: the nodes the passes skip.
-template <int D, class Shape>
+template <int D, class Shape, class Real>
 std::size_t expect_mass_inside_runs(Simulation& sim, const std::string& what) {
-  auto* stepper = dynamic_cast<Stepper<D, Shape, double>*>(&sim);
+  auto* stepper = dynamic_cast<Stepper<D, Shape, Real>*>(&sim);
   EXPECT_NE(stepper, nullptr) << what;
   if (!stepper) return 0;
   const NodeOwnership& own = stepper->ownership();
   EXPECT_NE(own.active, nullptr) << what << ": no runs with skip_empty_nodes = true";
   if (!own.active) return 0;
-  const GridView<D, double>& G = stepper->grid();
+  const GridView<D, Real>& G = stepper->grid();
   for (int f = 0; f < G.fields; ++f) {
     std::vector<char> in(G.nodes, 0);
     own.active->for_each(f, 0, G.nodes, [&](std::size_t b, std::size_t e) {
@@ -213,7 +213,7 @@ std::size_t expect_mass_inside_runs(Simulation& sim, const std::string& what) {
     });
     std::size_t outside = 0;
     for (std::size_t i = 0; i < G.nodes; ++i)
-      outside += G.m[std::size_t(f) * G.nodes + i] != 0.0 && !in[i];
+      outside += G.m[std::size_t(f) * G.nodes + i] != Real(0) && !in[i];
     EXPECT_EQ(outside, 0u) << what << " field " << f;
   }
   return G.nodes * std::size_t(G.fields) - own.active->node_count();
@@ -225,7 +225,7 @@ struct Runs {
 
 // min_gap: the skip run's shortest skipped gap (0: every empty part of a
 // row, which the default kMinSkippedNodes joins in grids this small).
-template <int D, class Shape>
+template <int D, class Shape, class Real = double>
 Runs make_both(const std::string& text, const std::string& file, std::vector<std::string> sets,
                std::size_t min_gap = 0) {
   auto scene = [&](bool skip) {
@@ -235,13 +235,13 @@ Runs make_both(const std::string& text, const std::string& file, std::vector<std
                         : parse_scene_file(kInputs + file, s);
   };
   Runs r{make_simulation(scene(true)), make_simulation(scene(false))};
-  auto* stepper = dynamic_cast<Stepper<D, Shape, double>*>(r.skip.get());
+  auto* stepper = dynamic_cast<Stepper<D, Shape, Real>*>(r.skip.get());
   EXPECT_NE(stepper, nullptr);
   if (stepper) stepper->set_min_skipped_nodes(min_gap);
   return r;
 }
 
-template <int D, class Shape>
+template <int D, class Shape, class Real = double>
 void run_both(const std::string& what, Runs r, int steps, int check) {
   std::size_t skipped = 0;
   for (int s = 1; s <= steps; ++s) {
@@ -250,7 +250,7 @@ void run_both(const std::string& what, Runs r, int steps, int check) {
     if (s % check == 0 || s == steps) {
       const std::string at = what + " step " + std::to_string(s);
       expect_bitwise_same(*r.skip, *r.all, at);
-      skipped = std::max(skipped, expect_mass_inside_runs<D, Shape>(*r.skip, at));
+      skipped = std::max(skipped, expect_mass_inside_runs<D, Shape, Real>(*r.skip, at));
       if (::testing::Test::HasFailure()) break;
     }
   }
@@ -300,6 +300,12 @@ TEST(ActiveNodes, ShippedScenesBitwise) {
   run_both<2, GimpShape>(
       "collision, USL",
       make_both<2, GimpShape>("", "collision.toml", {"grid.tile=4", "simulation.scheme=\"USL\""}),
+      60, 20);
+  // float: the same grid passes on the float columns.
+  run_both<2, GimpShape, float>(
+      "collision, float",
+      make_both<2, GimpShape, float>("", "collision.toml",
+                                     {"grid.tile=4", "simulation.precision=\"float\""}),
       60, 20);
 }
 
