@@ -74,9 +74,12 @@ std::array<double, 7> set_stage_counters(benchmark::State& state,
 // schemes. The Simulation is the one the step/... benchmarks of that scene
 // (without overrides) step.
 Simulation& step_scene_simulation(const std::string& scene);
-// The same scene with --set style overrides ("simulation.fuse_step_tail=false").
-Simulation& step_scene_simulation(const std::string& scene,
-                                  const std::vector<std::string>& overrides);
+// A new Simulation of the scene with --set style overrides
+// ("simulation.fuse_step_tail=false"), owned by the caller: bench_step_ab.cpp
+// compares two of the same age, where a shared one would have been stepped
+// by every benchmark before (its block moved on, its arrays placed earlier).
+std::unique_ptr<Simulation> new_step_scene_simulation(const std::string& scene,
+                                                      const std::vector<std::string>& overrides);
 Scheme step_scene_scheme(const std::string& scene);
 
 // Paired blocks (bench_step_pair.cpp, bench_step_ab.cpp): the seconds of one

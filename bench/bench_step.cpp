@@ -314,11 +314,12 @@ Simulation& step_scene_simulation(const std::string& scene) {
   return simulation_for(shared_case(scene));
 }
 
-Simulation& step_scene_simulation(const std::string& scene,
-                                  const std::vector<std::string>& overrides) {
+std::unique_ptr<Simulation> new_step_scene_simulation(const std::string& scene,
+                                                      const std::vector<std::string>& overrides) {
   StepCase c = shared_case(scene);
   c.overrides.insert(c.overrides.end(), overrides.begin(), overrides.end());
-  return simulation_for(c);
+  if (fixture_release()) fixture_release()();  // free the kernel fixtures
+  return make_simulation(parse_scene_text(c.text, c.scene + ".toml", c.overrides));
 }
 
 void register_step() {

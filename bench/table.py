@@ -421,6 +421,9 @@ PAIRED_SETTINGS = [
      "(B: skip_empty_nodes = false)",
      "A with the defaults (zeroing, momentum update, velocities over the nodes each field's "
      "particles can reach) and B over every node of every field", "skipping is faster", "grid"),
+    ("same_settings", "Control: two Simulations with the same settings, paired blocks",
+     "A and B both with the defaults (B made after A): what the harness itself puts between two "
+     "equal runs, the scale against which the rows above are read", "A is slower", "g2p"),
 ]
 
 
