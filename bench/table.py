@@ -708,7 +708,7 @@ def main():
     load_avg = context.get("load_avg")
     lines = ["# mmpm benchmark results", "",
              f"Tables written by `bench/table.py` from `bench/{os.path.basename(args.json)}`; reproduce with "
-             "`bench/run` (full, ~10 min) or `bench/run --quick` (subset, results on stdout). "
+             "`bench/run` (full, ~26 min) or `bench/run --quick` (subset, results on stdout). "
              "Only the notes at the end are hand-written.", "",
              f"- Date: {date}",
              f"- Machine: {model}, {cpus} CPU(s) (`lscpu`), {context.get('num_cpus', '?')} seen by "
