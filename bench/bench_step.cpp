@@ -209,6 +209,11 @@ struct StepCase {
   std::vector<std::string> overrides;
 };
 
+std::unique_ptr<Simulation> make_case_simulation(const StepCase& c) {
+  if (fixture_release()) fixture_release()();  // free the kernel fixtures
+  return make_simulation(parse_scene_text(c.text, c.scene + ".toml", c.overrides));
+}
+
 // Simulations stay alive for the whole step family (a few hundred MB at
 // most), so the 1- and 2-thread runs and the interleaved pairs share them.
 Simulation& simulation_for(const StepCase& c) {
@@ -216,10 +221,7 @@ Simulation& simulation_for(const StepCase& c) {
   std::string key = c.scene;
   for (const auto& o : c.overrides) key += "|" + o;
   auto& sim = sims[key];
-  if (!sim) {
-    if (fixture_release()) fixture_release()();  // free the kernel fixtures
-    sim = make_simulation(parse_scene_text(c.text, c.scene + ".toml", c.overrides));
-  }
+  if (!sim) sim = make_case_simulation(c);
   return *sim;
 }
 
@@ -318,8 +320,7 @@ std::unique_ptr<Simulation> new_step_scene_simulation(const std::string& scene,
                                                       const std::vector<std::string>& overrides) {
   StepCase c = shared_case(scene);
   c.overrides.insert(c.overrides.end(), overrides.begin(), overrides.end());
-  if (fixture_release()) fixture_release()();  // free the kernel fixtures
-  return make_simulation(parse_scene_text(c.text, c.scene + ".toml", c.overrides));
+  return make_case_simulation(c);
 }
 
 void register_step() {

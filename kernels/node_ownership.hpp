@@ -80,14 +80,15 @@ struct NodeOwnership {
 // with 8-cell tiles in 3D that left thread 0 ~30 % of the nodes of a block
 // filling its grid, and every node loop waited on the other thread
 // (docs/performance.md "A cut balanced inside the band"). With `active`
-// (kernels/active_nodes.hpp) the even split counts only the nodes the
-// loops visit: around a body in a large grid, half the grid's nodes may
+// (kernels/active_nodes.hpp) the loops visit only its runs, and the even
+// split counts only those nodes: around a body in a large grid, half the grid's nodes may
 // sit above it, all in one thread's share.
 template <int D>
 NodeOwnership node_ownership(const TileLayout<D>& layout, const std::array<int, 3>& nodes_per_dim,
                              const TileSchedule& schedule, std::size_t threads,
                              const FieldNodeRuns* active = nullptr) {
   NodeOwnership own;
+  own.active = active;
   std::size_t nodes = 1;
   for (int d = 0; d < D; ++d) nodes *= std::size_t(nodes_per_dim[std::size_t(d)]);
   if (threads < 2 || schedule.begin.empty() || schedule.begin.back() == 0) return own;

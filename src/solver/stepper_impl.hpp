@@ -361,13 +361,10 @@ std::pair<std::size_t, std::size_t> Stepper<D, Shape, Real>::color_share(std::si
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::update_node_ownership(bool rebuilt) {
   const auto threads = std::size_t(omp_get_max_threads());
-  if (rebuilt || own_threads_ != threads) {
-    own_threads_ = threads;
-    own_ = node_ownership<D>(tiles_, G_.nodes_per_dim, schedule_, threads,
-                             scene_.simulation.skip_empty_nodes ? &active_nodes_ : nullptr);
-  }
-  // Set at every call, not once, so it follows the Stepper's own member.
-  own_.active = scene_.simulation.skip_empty_nodes ? &active_nodes_ : nullptr;
+  if (!rebuilt && own_threads_ == threads) return;
+  own_threads_ = threads;
+  own_ = node_ownership<D>(tiles_, G_.nodes_per_dim, schedule_, threads,
+                           scene_.simulation.skip_empty_nodes ? &active_nodes_ : nullptr);
 }
 
 // The nodes each field's particles can reach, from the new tile ranges
