@@ -41,4 +41,15 @@ struct ParticleView {
   std::array<Real*, D> xlo{};
 };
 
+// A column pointer q with q[p] = block[p - first] for p >= first, so a
+// kernel that indexes by particle can keep one range's values of a column
+// in a block the size of that range (the fused tail's L,
+// solver/stepper_impl.hpp). Made through the address, as q lies before the
+// block; the flat address space of the targets we build for makes q[p]
+// the block's element.
+template <class T>
+T* offset_for_range(T* block, std::size_t first) {
+  return reinterpret_cast<T*>(reinterpret_cast<std::uintptr_t>(block) - first * sizeof(T));
+}
+
 }  // namespace mmpm

@@ -42,7 +42,7 @@ RULES = [
      "grid velocities (kernels/grid_update.hpp)"),
     # The per-material loops of one range: the constitutive pass's threads
     # and the fused step tail's tiles call it (solver/stepper_impl.hpp).
-    (r"^mmpm::Stepper<\d, mmpm::\w+, (float|double)>::constitutive_range\(unsigned long, unsigned long\)$", 30,
+    (r"^mmpm::Stepper<\d, mmpm::\w+, (float|double)>::constitutive_range\(unsigned long, unsigned long, mmpm::ParticleView<\d, (float|double)> const&\)$", 30,
      None, "constitutive update loops (kernels/constitutive.hpp)"),
 ]
 

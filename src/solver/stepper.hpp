@@ -117,13 +117,23 @@ class Stepper final : public Simulation {
   template <unsigned What>
   void g2p_colored();
   G2PParams g2p_params() const;
+  // On the particle view P: P_, or the fused tail's view whose L points
+  // into a per-thread scratch block (fused_step_tail).
   template <unsigned What>
-  G2PRangeResult g2p_range_of(const G2PParams& q, std::size_t begin, std::size_t end) const;
+  G2PRangeResult g2p_range_of(const G2PParams& q, std::size_t begin, std::size_t end,
+                              const ParticleView<D, Real>& P) const;
+  template <unsigned What>
+  G2PRangeResult g2p_range_of(const G2PParams& q, std::size_t begin, std::size_t end) const {
+    return g2p_range_of<What>(q, begin, end, P_);
+  }
   void collect(const std::vector<G2PRangeResult>& results);
   void constitutive();
   // The constitutive update of particles [lo, hi); returns the first
   // unsound particle there, or SIZE_MAX.
-  std::size_t constitutive_range(std::size_t lo, std::size_t hi);
+  std::size_t constitutive_range(std::size_t lo, std::size_t hi, const ParticleView<D, Real>& P);
+  std::size_t constitutive_range(std::size_t lo, std::size_t hi) {
+    return constitutive_range(lo, hi, P_);
+  }
   P2GOptions p2g_options() const;
   // The step's first P2G (What) of particles [b, e) with the scene's
   // template flags; p2g_range's contract.
@@ -179,6 +189,11 @@ class Stepper final : public Simulation {
   // MUSL's end-of-step positions, staggered like the particle columns (4 KiB aliasing)
   std::array<StaggeredArray<Real>, D> x_next_;
   std::vector<std::uint32_t> perm_, offsets_, scratch_keys_;
+  // The fused tail's L of one tile per thread (fused_step_tail): the
+  // velocity gradient lives from the tile's G2P to its constitutive update
+  // in the L1, and never reaches memory.
+  std::vector<Real> tail_L_;
+  std::size_t max_tile_particles_ = 0;
 
   TileLayout<D> tiles_;
   TileSchedule schedule_;  // tile ranges and each thread's tiles per color

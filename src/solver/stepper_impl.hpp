@@ -258,18 +258,28 @@ void Stepper<D, Shape, Real>::fused_step_tail() {
   std::vector<G2PRangeResult> res(tiles_.tile_count);
   std::size_t bad = SIZE_MAX, unsound = SIZE_MAX;
   double part[3] = {0, 0, 0};  // thread 0: gradient G2P, constitutive, P2G
+  // L of one tile per thread, columns a multiple of 64 bytes apart.
+  const std::size_t l_stride = (max_tile_particles_ + 7) / 8 * 8;
+  const std::size_t l_block = l_stride * std::size_t(D * D);
+  const std::size_t team = P_.n >= kParallelMin ? std::size_t(omp_get_max_threads()) : 1;
+  if (tail_L_.size() < team * l_block) tail_L_.assign(team * l_block, Real(0));
   for (std::size_t c = 0; c < schedule_.tiles.size(); ++c) {
     if (schedule_.tiles[c].empty()) continue;
 #pragma omp parallel reduction(min : bad, unsound) if (P_.n >= kParallelMin)
     {
       double mine[3] = {0, 0, 0};
+      ParticleView<D, Real> Pt = P_;
+      Real* const scratch = tail_L_.data() + std::size_t(omp_get_thread_num()) * l_block;
       for (auto [k, last] = color_share(c); k < last; ++k) {
         const std::uint32_t t = schedule_.tiles[c][k];
         const std::size_t b = schedule_.begin[t], e = schedule_.begin[t + 1];
+        // Pt.L[c][p] is scratch[c * l_stride + p - b] for p in [b, e).
+        for (int i = 0; i < D * D; ++i)
+          Pt.L[std::size_t(i)] = offset_for_range(scratch + std::size_t(i) * l_stride, b);
         const auto t0 = Clock::now();
-        res[t] = g2p_range_of<kCommitPosition | kVelocityGradient>(q, b, e);
+        res[t] = g2p_range_of<kCommitPosition | kVelocityGradient>(q, b, e, Pt);
         const auto t1 = Clock::now();
-        unsound = std::min(unsound, constitutive_range(b, e));
+        unsound = std::min(unsound, constitutive_range(b, e, Pt));
         const auto t2 = Clock::now();
         if (!res[t].moved_tile) {
           const std::size_t r = with_mm
@@ -338,6 +348,10 @@ void Stepper<D, Shape, Real>::rebuild_ranges() {
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::schedule_built() {
   const std::size_t n = P_.n;
+  max_tile_particles_ = 0;
+  for (std::size_t t = 0; t < tiles_.tile_count; ++t)
+    max_tile_particles_ =
+        std::max(max_tile_particles_, std::size_t(schedule_.begin[t + 1] - schedule_.begin[t]));
   if (scene_.simulation.skip_empty_nodes)
     update_active_nodes();  // before the split, which counts them
   update_node_ownership(true);
@@ -490,14 +504,15 @@ G2PParams Stepper<D, Shape, Real>::g2p_params() const {
 template <int D, class Shape, class Real>
 template <unsigned What>
 G2PRangeResult Stepper<D, Shape, Real>::g2p_range_of(const G2PParams& q, std::size_t b,
-                                                     std::size_t e) const {
+                                                     std::size_t e,
+                                                     const ParticleView<D, Real>& P) const {
   const KeyFn key_of = key_fn();
   auto run = [&]<bool MF, bool TR, bool GR>() {
     if constexpr ((What & kStressUpdate) != 0)
       return g2p_range<D, Shape, Real, What, MF, TR, GR>(
-          P_, G_, GV_, q, key_of, b, e, IsotropicStressUpdate<D, Real>{stress_table_.data()});
+          P, G_, GV_, q, key_of, b, e, IsotropicStressUpdate<D, Real>{stress_table_.data()});
     else
-      return g2p_range<D, Shape, Real, What, MF, TR, GR>(P_, G_, GV_, q, key_of, b, e);
+      return g2p_range<D, Shape, Real, What, MF, TR, GR>(P, G_, GV_, q, key_of, b, e);
   };
   if (plan_.multimaterial) {
     if (has_traction_)
@@ -586,8 +601,9 @@ void Stepper<D, Shape, Real>::constitutive() {
 }
 
 template <int D, class Shape, class Real>
-std::size_t Stepper<D, Shape, Real>::constitutive_range(std::size_t lo, std::size_t hi) {
-  if (isotropic_by_material_) isotropic_table_.range(P_, lo, hi);
+std::size_t Stepper<D, Shape, Real>::constitutive_range(std::size_t lo, std::size_t hi,
+                                                       const ParticleView<D, Real>& P) {
+  if (isotropic_by_material_) isotropic_table_.range(P, lo, hi);
   for (std::size_t mi = 0; mi < materials_.size() && !isotropic_by_material_; ++mi) {
     const MaterialModel& mat = materials_[mi];
     const std::uint32_t* idx = nullptr;
@@ -600,19 +616,19 @@ std::size_t Stepper<D, Shape, Real>::constitutive_range(std::size_t lo, std::siz
     }
     switch (mat.type) {
       case MaterialType::isotropic:
-        update_particles(P_, idx, first, last, IsotropicPoint<D, Real>(mat.k, dt_));
+        update_particles(P, idx, first, last, IsotropicPoint<D, Real>(mat.k, dt_));
         break;
       case MaterialType::transverse:
-        update_particles(P_, idx, first, last, AnisotropicPoint<D, Real>(mat.k, dt_));
+        update_particles(P, idx, first, last, AnisotropicPoint<D, Real>(mat.k, dt_));
         break;
       case MaterialType::neohookean:
-        update_particles(P_, idx, first, last, NeoHookeanPoint<D, Real>(mat.k, dt_));
+        update_particles(P, idx, first, last, NeoHookeanPoint<D, Real>(mat.k, dt_));
         break;
       case MaterialType::rigid:
         break;
     }
   }
-  return first_unsound(P_, lo, hi);
+  return first_unsound(P, lo, hi);
 }
 
 template <int D, class Shape, class Real>
