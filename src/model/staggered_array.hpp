@@ -8,8 +8,9 @@
 // pages, madvise mode on Debian 12): a step over 10^6 particles otherwise
 // walks ~40 000 4 KiB pages of particle columns, plus the grid's rows, per
 // pass. Measured gain is small, 1-3 % of a 2D linear step at 10^6
-// particles (docs/performance.md "Huge pages"). The stagger stays an
-// offset within the first 4 KiB, so the aliasing argument above holds.
+// particles (docs/performance.md, "Huge pages for large arrays"). The
+// stagger stays an offset within the first 4 KiB, so the aliasing argument
+// above holds.
 #pragma once
 
 #include <algorithm>

@@ -273,7 +273,7 @@ void Stepper<D, Shape, Real>::fused_step_tail() {
       for (auto [k, last] = color_share(c); k < last; ++k) {
         const std::uint32_t t = schedule_.tiles[c][k];
         const std::size_t b = schedule_.begin[t], e = schedule_.begin[t + 1];
-        // Pt.L[c][p] is scratch[c * l_stride + p - b] for p in [b, e).
+        // Pt.L[i][p] is scratch[i * l_stride + p - b] for p in [b, e).
         for (int i = 0; i < D * D; ++i)
           Pt.L[std::size_t(i)] = offset_for_range(scratch + std::size_t(i) * l_stride, b);
         const auto t0 = Clock::now();
