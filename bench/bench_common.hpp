@@ -186,6 +186,7 @@ template <int D, class Real>
 struct ParticleSet {
   std::vector<StaggeredArray<Real>> reals;  // every real column, permuted together
   std::vector<StaggeredArray<std::uint8_t>> bytes;
+  std::vector<StaggeredArray<Real>> transient;  // L: lives within a step, never permuted
   StaggeredArray<std::uint32_t> key;
   StaggeredArray<std::uint32_t> id;  // seed index (the Stepper's tie-break in the sort)
   ParticleView<D, Real> P;
@@ -194,6 +195,7 @@ struct ParticleSet {
   ParticleSet() {
     reals.reserve(64);
     bytes.reserve(4);
+    transient.reserve(16);
   }
   ParticleSet(const ParticleSet&) = delete;
   ParticleSet& operator=(const ParticleSet&) = delete;
@@ -205,10 +207,15 @@ struct ParticleSet {
     bytes.emplace_back(n, slot++);
     return bytes.back().data();
   }
+  Real* add_transient(std::size_t n) {
+    transient.emplace_back(n, slot++);
+    return transient.back().data();
+  }
   std::size_t size() const { return P.n; }
   // Bytes a particle occupies over all its columns.
   std::size_t bytes_per_particle() const {
-    return reals.size() * sizeof(Real) + bytes.size() + 2 * sizeof(std::uint32_t);
+    return (reals.size() + transient.size()) * sizeof(Real) + bytes.size() +
+           2 * sizeof(std::uint32_t);
   }
 };
 
@@ -235,7 +242,7 @@ void make_block(ParticleSet<D, Real>& S, const BlockSpec& b) {
   P.m = S.add_real(n);
   P.V = S.add_real(n);
   for (int c = 0; c < NS; ++c) P.s[c] = S.add_real(n);
-  for (int c = 0; c < D * D; ++c) P.L[c] = S.add_real(n);
+  for (int c = 0; c < D * D; ++c) P.L[c] = S.add_transient(n);
   for (int d = 0; d < D; ++d) P.x0[d] = S.add_real(n);
   if (b.gimp)
     for (int d = 0; d < D; ++d) P.lp[d] = S.add_real(n);

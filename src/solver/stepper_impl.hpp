@@ -94,7 +94,13 @@ void Stepper<D, Shape, Real>::setup_particles(const ParticleSeeds& seeds) {
   P_.m = pcols_.add_real("m", n);
   P_.V = pcols_.add_real("V", n);
   for (int c = 0; c < NS; ++c) P_.s[c] = pcols_.add_real("s" + std::to_string(c), n);
-  for (int c = 0; c < D * D; ++c) P_.L[c] = pcols_.add_real("L" + std::to_string(c), n);
+  // L lives within a step (G2P writes it, the constitutive update reads
+  // it): no particle column, so sorts do not permute it and checkpoints do
+  // not carry it.
+  for (int c = 0; c < D * D; ++c) {
+    L_[std::size_t(c)].allocate(n, pcols_.next_slot++);
+    P_.L[std::size_t(c)] = L_[std::size_t(c)].data();
+  }
   if (finite)
     for (int c = 0; c < D * D; ++c) P_.H[c] = pcols_.add_real("H" + std::to_string(c), n);
   if (need_x0)
