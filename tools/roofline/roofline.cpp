@@ -144,15 +144,19 @@ std::vector<Row> rows_of(const Case& c, bool musl, double nodes_per_particle) {
   // The force needs the in-plane stresses only: 3 of the 4 in 2D (not zz).
   const int NS_force = D == 2 ? 3 : 6;
   const double p2g_bytes = R * (2 * D + 2 + NS_force + lp) + grid * (1 + 2 * D);
+  // L goes through memory in USL (G2P writes it, the constitutive pass
+  // reads it); MUSL's fused tail keeps it in a per-thread block of one tile
+  // (solver/stepper_impl.hpp fused_step_tail), so it moves no bytes there.
+  const int L = musl ? 0 : D * D;
   // USL's G2P reads x, (lp), v and writes v, x, L; MUSL's two passes (the
   // first scatters m v, the gradient pass moves x) read m too, once.
   const double g2p_bytes =
-      R * (2 * D + lp + (musl ? 1 : 0)) + 4 + R * (2 * D + D * D) + grid / 2 * (2 * D);
-  const double con_bytes = R * (D * D + NS + 1) + R * (NS + 1);
+      R * (2 * D + lp + (musl ? 1 : 0)) + 4 + R * (2 * D + L) + grid / 2 * (2 * D);
+  const double con_bytes = R * (L + NS + 1) + R * (NS + 1);
   // The step: every persistent column once; reads x, v, m, V, sigma, (lp),
-  // key; writes x, v, V, sigma, L; the grid's m, p, f, vel, dvel.
+  // key; writes x, v, V, sigma (and L in USL); the grid's m, p, f, vel, dvel.
   const double step_bytes =
-      R * (2 * D + 2 + NS + lp) + 4 + R * (2 * D + 1 + NS + D * D) + grid * (1 + 4 * D);
+      R * (2 * D + 2 + NS + lp) + 4 + R * (2 * D + 1 + NS + L) + grid * (1 + 4 * D);
   const double stencil = D * (c.S == 2 ? 4.0 : 14.0) + nodes * (D + 1.0);
   const double p2g_flops = stencil + 2 * D + NS + nodes * (2.0 + 2 * D + 4.0 * D);
   const double one_g2p = stencil + nodes * (4.0 * D + 2.0 * D * D) + 6 * D;
@@ -282,7 +286,7 @@ int main(int argc, char** argv) {
       "peak. x bound: median over the blocks of time / bound at the block's own machine "
       "(mean of the measurements before and after it); x b. min: best time / best bound. "
       "Below 1: the stage found columns in the cache that the count charges to memory (the "
-      "constitutive update reads L and sigma right after the G2P that wrote L).\n");
+      "constitutive update reads sigma, and in USL L, right after the G2P pass).\n");
   if (all_gbs.empty()) return 1;  // every case was skipped
   std::printf(
       "Over the run: triad %.1f to %.1f GB/s (median %.1f), peak %.0f to %.0f GFLOP/s "
