@@ -539,8 +539,8 @@ def scaling_section(R):
     ns = "ns_per_particle"
     out = ["## 7. Problem size: 10^4 to 10^7 particles (2D linear, whole step, ns/particle/step)", "",
            "The `2d_linear_1mat` scene (MUSL) with a square block of N particles (2 × 2 per cell). "
-           "grid MiB = nodes × 9 arrays × 8 bytes, particle MiB = N × 20 arrays × 8 bytes "
-           "(what the step touches). This machine: 48 KiB L1d and 1 MiB L2 per core, 32 MiB L3 "
+           "grid MiB = nodes × 9 arrays × 8 bytes, particle MiB = N × 16 arrays × 8 bytes "
+           "(what the step touches; 20 before L left the particle arrays on 2026-11-26). This machine: 48 KiB L1d and 1 MiB L2 per core, 32 MiB L3 "
            "shared.", ""]
     header = ["particles", "grid MiB", "particle MiB", "1 thread", "2 threads", "speed-up",
               "p2g (1t)", "g2p (1t)", "grid (1t)", "constitutive (1t)"]

@@ -186,7 +186,8 @@ class Stepper final : public Simulation {
   GridView<D, Real> G_;
   GridVelocity<D, Real> GV_;
   std::vector<Real> scratch_;
-  // The velocity gradient (setup_particles), staggered like the columns.
+  // The velocity gradient of every particle (gradient_and_stress),
+  // staggered like the columns.
   std::array<StaggeredArray<Real>, D * D> L_;
   // MUSL's end-of-step positions, staggered like the particle columns (4 KiB aliasing)
   std::array<StaggeredArray<Real>, D> x_next_;

@@ -94,13 +94,9 @@ void Stepper<D, Shape, Real>::setup_particles(const ParticleSeeds& seeds) {
   P_.m = pcols_.add_real("m", n);
   P_.V = pcols_.add_real("V", n);
   for (int c = 0; c < NS; ++c) P_.s[c] = pcols_.add_real("s" + std::to_string(c), n);
-  // L lives within a step (G2P writes it, the constitutive update reads
-  // it): no particle column, so sorts do not permute it and checkpoints do
-  // not carry it.
-  for (int c = 0; c < D * D; ++c) {
-    L_[std::size_t(c)].allocate(n, pcols_.next_slot++);
-    P_.L[std::size_t(c)] = L_[std::size_t(c)].data();
-  }
+  // L is no column: it lives within a step (G2P writes it, the
+  // constitutive update reads it), so sorts do not permute it and
+  // checkpoints do not carry it; gradient_and_stress allocates it.
   if (finite)
     for (int c = 0; c < D * D; ++c) P_.H[c] = pcols_.add_real("H" + std::to_string(c), n);
   if (need_x0)
@@ -640,6 +636,13 @@ std::size_t Stepper<D, Shape, Real>::constitutive_range(std::size_t lo, std::siz
 template <int D, class Shape, class Real>
 template <unsigned What>
 void Stepper<D, Shape, Real>::gradient_and_stress() {
+  // The only passes that keep L for every particle: MUSL's fused tail keeps
+  // a tile's L at a time, so a run that only takes the tail never allocates it.
+  for (int c = 0; c < D * D; ++c) {
+    auto& column = L_[std::size_t(c)];
+    if (column.size() != P_.n) column.allocate(P_.n, pcols_.next_slot++);
+    P_.L[std::size_t(c)] = column.data();
+  }
   if (fuse_constitutive_) {
     tic();
     g2p<What | kVelocityGradient | kStressUpdate>();
