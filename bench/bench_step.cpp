@@ -7,6 +7,8 @@
 //   3d_gimp_1mat      3D gimp, one elastic material, 101 376 particles
 //   2d_linear_room    2d_linear_1mat's block in a grid of 504 x 504 cells
 //                     (step_ab only: node passes over empty nodes)
+//   2d_linear_1e6     the same block with 10^6 particles, grid 504 x 504
+//                     cells (step_ab only: the tile edge at large N)
 //   2d_gimp_inclusions 2D gimp, 625 glass disks in a polymer block, interface
 //                     (inclusions_scene); with mm_fields_share = 1 (fields
 //                     always apart), and the two-layer scene with 0 (always
@@ -281,6 +283,7 @@ StepCase shared_case(const std::string& scene) {
   // The 2D linear block in a grid twice as wide and tall: three quarters
   // of the nodes are empty, as around a body with room to move.
   if (scene == "2d_linear_room") return {scene, linear_block_scene(250), {"grid.cells=[504, 504]"}};
+  if (scene == "2d_linear_1e6") return {scene, linear_block_scene(500), {}};
   throw std::invalid_argument("no whole-step scene named " + scene);
 }
 

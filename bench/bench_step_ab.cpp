@@ -75,22 +75,30 @@ void register_step_ab() {
   // B: one setting away from the defaults (A). fuse_step_tail: MUSL's step
   // tail as three separate passes; particle_order: particles stored in
   // plain tile order instead of color by color; skip_empty_nodes: the node
-  // passes over every node of every field; same_settings: B as A (the
-  // control).
+  // passes over every node of every field; tile: another tile edge;
+  // same_settings: B as A (the control).
   const std::pair<const char*, const char*> settings[] = {
       {"fuse_step_tail_false", "simulation.fuse_step_tail=false"},
       {"particle_order_tile", "simulation.particle_order=\"tile\""},
       {"skip_empty_nodes_false", "simulation.skip_empty_nodes=false"},
+      {"tile_32", "grid.tile=32"},
+      {"tile_16", "grid.tile=16"},
       {"same_settings", ""}};
   for (const auto& [label, override_b] : settings)
     for (const char* scene : {"2d_linear_1mat", "2d_gimp_interface", "2d_gimp_inclusions",
-                              "3d_gimp_1mat", "2d_linear_room"})
+                              "3d_gimp_1mat", "2d_linear_room", "2d_linear_1e6"})
       for (int threads : {1, 2}) {
-        // The roomy grid only for the setting it is there for.
-        const bool room = std::string(scene) == "2d_linear_room";
-        if (room && std::string(label) != "skip_empty_nodes_false" &&
-            std::string(label) != "same_settings")
-          continue;
+        // The roomy grid and the 10^6 block only for the setting each is
+        // there for; the tile edge the other way from the default: 32 on
+        // the 254^2 grids, whose default is 16, 16 on the 10^6 block's
+        // 504^2 grid, whose default is 32 (Stepper::setup_grid); not in 3D.
+        const std::string sc = scene, lb = label;
+        if (lb != "same_settings") {
+          if (sc == "2d_linear_room" && lb != "skip_empty_nodes_false") continue;
+          if (sc == "2d_linear_1e6" && lb != "tile_16") continue;
+          if (lb == "tile_16" && sc != "2d_linear_1e6") continue;
+          if (lb == "tile_32" && (sc == "3d_gimp_1mat" || sc == "2d_linear_room")) continue;
+        }
         const std::string name = std::string("step_ab/scene:") + scene + "/b:" + label +
                                  "/threads:" + std::to_string(threads);
         const std::string b = override_b;

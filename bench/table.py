@@ -353,6 +353,7 @@ STEP_SCENES = [
     ("2d_gimp_1mat", "2D gimp, same geometry, 1 material (baseline)"),
     ("2d_gimp_2mat_shared", "2D gimp, 2 materials sharing one field"),
     ("2d_linear_room", "2D linear block in a 504 × 504 grid, 3/4 of the nodes empty (step_ab only)"),
+    ("2d_linear_1e6", "2D linear block of 10^6 particles, 504 × 504 grid (step_ab only)"),
 ]
 
 
@@ -421,6 +422,12 @@ PAIRED_SETTINGS = [
      "(B: skip_empty_nodes = false)",
      "A with the defaults (zeroing, momentum update, velocities over the nodes each field's "
      "particles can reach) and B over every node of every field", "skipping is faster", "grid"),
+    ("tile_32", "Tile edge 32 on the 254² grids, paired blocks (B: grid.tile = 32)",
+     "A with the defaults (tile edge 16 on these grids: 32 would leave 16 tiles per color) and "
+     "B with 32", "the default 16 is faster", "p2g"),
+    ("tile_16", "Tile edge 16 on the 504² grid, paired blocks (B: grid.tile = 16)",
+     "A with the defaults (tile edge 32 on this grid, 64 tiles per color) and B with 16 (the "
+     "edge of every 2D grid before 2026-11-26)", "the default 32 is faster", "p2g"),
     ("same_settings", "Control: two Simulations with the same settings, paired blocks",
      "A and B both with the defaults (B made after A): what the harness itself puts between two "
      "equal runs, the scale against which the rows above are read", "A is slower", "g2p"),

@@ -214,6 +214,26 @@ TEST(Determinism, ImperfectInterfaceNumericDnMUSL2D) {
       << "a compliant interface stores energy once it opens or slides";
 }
 
+// The largest tile edges the default picks (64 in 2D on grids from 726^2
+// cells; 32 from 363^2), here forced on the 110 x 90 grid: 4 and 12
+// tiles, so one color holds one tile (one thread idle) or a few, and the
+// fused tail's per-thread L block holds up to 64^2 cells of particles.
+TEST(Determinism, ImperfectInterfaceLargeTiles2D) {
+  for (const char* edge : {"32", "64"}) {
+    SCOPED_TRACE(std::string("tile ") + edge);
+    BoxScene2D s = two_materials("double", kNumericInterface);
+    s.scheme = "MUSL";  // the fused tail
+    std::string text = s.text();
+    const std::size_t grid = text.find("[grid]\n");
+    ASSERT_NE(grid, std::string::npos);
+    text.insert(grid + 7, std::string("tile = ") + edge + "\n");
+    EXPECT_EQ(make_simulation(parse_scene_text(text, "tiles.toml"))->tile_edge(), std::stoi(edge));
+    const RunResult r = check_scene(text, "2D gimp double", 40.0);
+    EXPECT_GT(r.counters.multimaterial_nodes, 0);
+    EXPECT_GT(r.counters.p2g_from_tail, 0) << "the fused tail must have run";
+  }
+}
+
 TEST(Determinism, ImperfectInterfaceFloat2D) {
   const RunResult r =
       check_scene(two_materials("float", kNumericInterface).text(), "2D gimp float", 40.0);
