@@ -53,6 +53,7 @@ void register_mm_scene();
 void register_scaling();
 void register_step_pair();
 void register_step_ab();
+void register_seed();
 
 // The 2D linear one-material scene (bench_scaling.cpp): a square block of
 // `cells` x `cells` cells, 2 x 2 particles per cell, in a grid 4 cells wider.

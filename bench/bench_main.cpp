@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
   mmpm::bench::register_step_ab();
   mmpm::bench::register_mm_scene();
   mmpm::bench::register_scaling();
+  mmpm::bench::register_seed();
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   benchmark::AddCustomContext("omp_max_threads", std::to_string(omp_get_max_threads()));

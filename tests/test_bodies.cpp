@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdint>
+#include <sstream>
 
 #include "model/bodies.hpp"
 #include "scene/parse.hpp"
@@ -81,6 +83,126 @@ TEST(Bodies, OverlapReplacementAndTractionTotal) {
   double fy = 0;
   for (const auto& f : s.traction_force) fy += f[1];
   EXPECT_NEAR(fy, 3.0 * 2.0 * 1.0, 1e-12);
+}
+
+// Overlap replacement against its definition, on many overlapping bodies:
+// the particles are the lattice points of each body (every cell of the grid
+// tried, in make_particles' loop order) that no later body contains, body
+// after body. make_particles tests only the particles in the cells of a
+// later body's bounding box (seeding was O(particles x bodies) before), so
+// this also checks that the box holds every point the body contains:
+// rotated boxes with and without a pivot, disks, polygons, clip boxes,
+// spheres, cylinders, 1-3 particles per cell. Exact: same points, same
+// order, same bodies.
+// `replaced`: how many points a later body took over.
+std::vector<std::pair<Vec3, int>> seeds_by_definition(const Scene& scene, std::size_t& replaced) {
+  const int dim = scene.simulation.dimension;
+  const GridSpec& g = scene.grid;
+  std::vector<std::pair<Vec3, int>> kept;
+  for (std::size_t b = 0; b < scene.bodies.size(); ++b) {
+    const BodySpec& body = scene.bodies[b];
+    replaced += std::erase_if(kept, [&](const auto& e) { return inside_body(body, e.first, dim); });
+    const int ppc = body.particles_per_cell, sub_z = dim == 3 ? ppc : 1;
+    for (int cz = 0; cz < (dim == 3 ? g.cells[2] : 1); ++cz)
+      for (int cy = 0; cy < g.cells[1]; ++cy)
+        for (int cx = 0; cx < g.cells[0]; ++cx)
+          for (int kz = 0; kz < sub_z; ++kz)
+            for (int ky = 0; ky < ppc; ++ky)
+              for (int kx = 0; kx < ppc; ++kx) {
+                Vec3 x{g.origin[0] + (cx + (kx + 0.5) / ppc) * g.cell[0],
+                       g.origin[1] + (cy + (ky + 0.5) / ppc) * g.cell[1], 0.0};
+                if (dim == 3) x[2] = g.origin[2] + (cz + (kz + 0.5) / ppc) * g.cell[2];
+                if (inside_body(body, x, dim)) kept.emplace_back(x, int(b));
+              }
+  }
+  return kept;
+}
+
+void expect_seeds_by_definition(const std::string& text, const char* label) {
+  const Scene scene = parse_scene_text(text, label);
+  const ParticleSeeds s = make_particles(scene);
+  std::size_t replaced = 0;
+  const auto want = seeds_by_definition(scene, replaced);
+  ASSERT_EQ(s.x.size(), want.size());
+  std::size_t differ = 0;
+  for (std::size_t p = 0; p < want.size(); ++p)
+    differ += s.x[p] != want[p].first || s.body[p] != want[p].second;
+  EXPECT_EQ(differ, 0u);
+  // The scene must exercise the replacement: many points taken over.
+  EXPECT_GT(replaced, want.size() / 10);
+}
+
+struct Lcg {
+  std::uint64_t state;
+  double next(double lo, double hi) {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return lo + (hi - lo) * double(state >> 11) / double(1ull << 53);
+  }
+};
+
+TEST(Bodies, ManyOverlapsMatchTheDefinition2D) {
+  // 16 x 16 mm grid of 0.5 mm cells; bodies inside [-3, 3]^2 so that every
+  // shape keeps its margin from the grid edge.
+  std::ostringstream t;
+  t << kBase << "[[body]]\nmaterial = \"a\"\nshape = \"box\"\nmin = [-3.0, -3.0]\n"
+    << "max = [3.0, 3.0]\nparticles_per_cell = 2\n";
+  Lcg r{42};
+  for (int b = 0; b < 36; ++b) {
+    const double cx = r.next(-2.0, 2.0), cy = r.next(-2.0, 2.0), size = r.next(0.4, 1.0);
+    const int ppc = 1 + b % 3;
+    t << "[[body]]\nmaterial = \"a\"\nparticles_per_cell = " << ppc << "\n";
+    switch (b % 4) {
+      case 0:
+        t << "shape = \"box\"\nmin = [" << cx - size << ", " << cy - 0.5 * size << "]\nmax = ["
+          << cx + size << ", " << cy + 0.5 * size << "]\nrotate = " << r.next(-80, 80) << "\n";
+        if (b % 8 == 0) t << "pivot = [" << cx + 0.3 << ", " << cy - 0.2 << "]\n";
+        break;
+      case 1:
+        t << "shape = \"disk\"\ncenter = [" << cx << ", " << cy << "]\nradius = " << size << "\n";
+        break;
+      case 2:
+        t << "shape = \"polygon\"\npoints = [[" << cx - size << ", " << cy - size << "], ["
+          << cx + size << ", " << cy - 0.2 * size << "], [" << cx - 0.1 * size << ", " << cy + size
+          << "]]\nrotate = " << r.next(-80, 80) << "\n";
+        break;
+      default:
+        t << "shape = \"disk\"\ncenter = [" << cx << ", " << cy << "]\nradius = " << size
+          << "\nclip = { min = [" << cx - size << ", " << cy - 0.4 * size << "], max = ["
+          << cx + 0.5 * size << ", " << cy + size << "] }\n";
+    }
+  }
+  expect_seeds_by_definition(t.str(), "overlaps2d.toml");
+}
+
+TEST(Bodies, ManyOverlapsMatchTheDefinition3D) {
+  std::ostringstream t;
+  t << "[simulation]\ndimension = 3\nend_time = 1.0\n[grid]\norigin = [-4.0, -4.0, -4.0]\n"
+    << "cell = [0.5, 0.5, 0.5]\ncells = [16, 16, 16]\nshape = \"linear\"\n"
+    << "[[material]]\nname = \"a\"\ntype = \"isotropic\"\ndensity = 1.0\nE = 100.0\nnu = 0.3\n"
+    << "[[body]]\nmaterial = \"a\"\nshape = \"box\"\nmin = [-3.0, -3.0, -3.0]\n"
+    << "max = [3.0, 3.0, 3.0]\n";
+  Lcg r{7};
+  for (int b = 0; b < 15; ++b) {
+    const double c[3] = {r.next(-2, 2), r.next(-2, 2), r.next(-2, 1)};
+    const double size = r.next(0.4, 1.0);
+    t << "[[body]]\nmaterial = \"a\"\nparticles_per_cell = " << 1 + b % 3 << "\n";
+    const std::string centre = "[" + std::to_string(c[0]) + ", " + std::to_string(c[1]) + ", " +
+                               std::to_string(c[2]) + "]";
+    switch (b % 3) {
+      case 0:
+        t << "shape = \"box\"\nmin = [" << c[0] - size << ", " << c[1] - size << ", " << c[2]
+          << "]\nmax = [" << c[0] + 0.5 * size << ", " << c[1] + size << ", " << c[2] + size
+          << "]\n";
+        break;
+      case 1:
+        t << "shape = \"sphere\"\ncenter = " << centre << "\nradius = " << size << "\n";
+        break;
+      default:
+        t << "shape = \"cylinder\"\ncenter = " << centre << "\nradius = " << size
+          << "\nlength = " << 2 * size << "\n";
+    }
+  }
+  expect_seeds_by_definition(t.str(), "overlaps3d.toml");
 }
 
 }  // namespace

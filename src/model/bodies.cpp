@@ -1,8 +1,12 @@
 #include "model/bodies.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstddef>
+#include <cstdint>
 #include <numbers>
+#include <vector>
 
 #include "scene/error.hpp"
 
@@ -86,6 +90,49 @@ std::pair<Vec3, Vec3> bounds(const BodySpec& b, int dim) {
   return {lo, hi};
 }
 
+// The seeded particles of each grid cell, as lists threaded through the
+// particles (head per cell, next per particle), for the replacement of
+// earlier bodies' particles by a later body (make_particles).
+class SeedCells {
+ public:
+  SeedCells(const GridSpec& g, int dim, bool needed) : needed_(needed) {
+    if (!needed_) return;
+    for (int d = 0; d < 3; ++d) n_[d] = d < dim ? std::size_t(g.cells[d]) : 1;
+    head_.assign(n_[0] * n_[1] * n_[2], kNone);
+  }
+  // Particle p, seeded in cell c.
+  void add(std::size_t p, std::array<int, 3> c) {
+    if (!needed_) return;
+    const std::size_t k = index(c);
+    next_.resize(p + 1, kNone);
+    next_[p] = head_[k];
+    head_[k] = p;
+  }
+  // f(p) for every particle seeded in cells c0 .. c1 (inclusive), widened
+  // by one cell on each side within the grid.
+  template <class F>
+  void for_each_in(std::array<int, 3> c0, std::array<int, 3> c1, int dim, F&& f) const {
+    if (!needed_) return;
+    for (int d = 0; d < dim; ++d) {
+      c0[d] = std::max(0, c0[d] - 1);
+      c1[d] = std::min(int(n_[d]) - 1, c1[d] + 1);
+    }
+    for (int cz = c0[2]; cz <= c1[2]; ++cz)
+      for (int cy = c0[1]; cy <= c1[1]; ++cy)
+        for (int cx = c0[0]; cx <= c1[0]; ++cx)
+          for (std::size_t p = head_[index({cx, cy, cz})]; p != kNone; p = next_[p]) f(p);
+  }
+
+ private:
+  static constexpr std::size_t kNone = SIZE_MAX;
+  std::size_t index(std::array<int, 3> c) const {
+    return (std::size_t(c[2]) * n_[1] + std::size_t(c[1])) * n_[0] + std::size_t(c[0]);
+  }
+  bool needed_;
+  std::size_t n_[3] = {1, 1, 1};
+  std::vector<std::size_t> head_, next_;
+};
+
 }  // namespace
 
 bool inside_body(const BodySpec& b, const Vec3& x, int dim) {
@@ -129,11 +176,9 @@ ParticleSeeds make_particles(const Scene& scene) {
     for (std::size_t m = 0; m < scene.materials.size(); ++m)
       if (scene.materials[m].name == scene.bodies[b].material) material_index[b] = int(m);
 
+  SeedCells cells(g, dim, scene.bodies.size() > 1);
   for (std::size_t bi = 0; bi < scene.bodies.size(); ++bi) {
     const BodySpec& body = scene.bodies[bi];
-    // Later bodies replace earlier particles inside them.
-    for (std::size_t p = 0; p < out.x.size(); ++p)
-      if (alive[p] && inside_body(body, out.x[p], dim)) alive[p] = 0;
     const int ppc = body.particles_per_cell;
     auto [lo, hi] = bounds(body, dim);
     std::array<int, 3> c0{0, 0, 0}, c1{0, 0, 0};
@@ -141,6 +186,14 @@ ParticleSeeds make_particles(const Scene& scene) {
       c0[d] = std::max(0, int(std::floor((lo[d] - g.origin[d]) / g.cell[d])));
       c1[d] = std::min(g.cells[d] - 1, int(std::floor((hi[d] - g.origin[d]) / g.cell[d])));
     }
+    // Later bodies replace earlier particles inside them. Only particles in
+    // the cells of the body's bounding box can be inside it, one cell of
+    // margin against round-off: testing every particle made seeding
+    // O(particles x bodies), 12 s for 2 500 disks in 10^6 particles.
+    if (bi > 0)
+      cells.for_each_in(c0, c1, dim, [&](std::size_t p) {
+        if (alive[p] && inside_body(body, out.x[p], dim)) alive[p] = 0;
+      });
     double volume = 1;
     Vec3 half{0, 0, 0};
     for (int d = 0; d < dim; ++d) {
@@ -169,6 +222,7 @@ ParticleSeeds make_particles(const Scene& scene) {
                 out.traction_force.push_back({0, 0, 0});
                 out.load.push_back(-1);
                 alive.push_back(1);
+                cells.add(out.x.size() - 1, {cx, cy, cz});
                 ++added;
               }
     if (added == 0)

@@ -1,0 +1,84 @@
+// Seeding cost (make_particles, src/model/bodies.cpp): a 250 x 250 mm
+// polymer block on a 254² grid of 1 mm cells, 2 x 2 particles per cell
+// (250 000 particles), holding n x n glass disks (radius 0.3 of the pitch)
+// that replace the block's particles inside them: the particle-filled
+// polymer a user seeds once per run. n = 0 is the block alone, the baseline
+// of the ratio in bench/RESULTS.md. The scene is parsed once, outside the
+// timer. Before 2026-11-26 every later body tested every particle seeded so
+// far (O(particles x bodies)); now only those in its bounding box's cells.
+#include <string>
+
+#include "bench/bench_common.hpp"
+#include "model/bodies.hpp"
+#include "scene/parse.hpp"
+
+namespace mmpm::bench {
+namespace {
+
+std::string disks_scene(int n) {
+  std::string s = R"(
+[simulation]
+dimension = 2
+end_time  = 1.0
+
+[grid]
+origin = [0.0, 0.0]
+cell   = [1.0, 1.0]
+cells  = [254, 254]
+shape  = "gimp"
+
+[[material]]
+name    = "polymer"
+type    = "isotropic"
+density = 1.2e-3
+E       = 2400.0
+nu      = 0.33
+
+[[material]]
+name    = "glass"
+type    = "isotropic"
+density = 2.5e-3
+E       = 70000.0
+nu      = 0.22
+
+[[body]]
+material = "polymer"
+shape    = "box"
+min      = [2.0, 2.0]
+max      = [252.0, 252.0]
+particles_per_cell = 2
+)";
+  const double pitch = n > 0 ? 250.0 / n : 0.0;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      s += "\n[[body]]\nmaterial = \"glass\"\nshape = \"disk\"\ncenter = [" +
+           std::to_string(2.0 + pitch * (i + 0.5)) + ", " +
+           std::to_string(2.0 + pitch * (j + 0.5)) + "]\nradius = " + std::to_string(0.3 * pitch) +
+           "\nparticles_per_cell = 2\n";
+  return s;
+}
+
+void bm_seed(benchmark::State& state, int n) {
+  const Scene scene = parse_scene_text(disks_scene(n), "disks.toml");
+  std::size_t particles = 0;
+  for (auto _ : state) {
+    const ParticleSeeds s = make_particles(scene);
+    particles = s.x.size();
+    keep(particles);
+  }
+  set_ns_per_particle(state, double(particles));
+  state.counters["bodies"] = double(scene.bodies.size());
+}
+
+}  // namespace
+
+void register_seed() {
+  for (int n : {0, 25, 50, 100}) {
+    const std::string name = "seed/disks:" + std::to_string(n * n) + "/threads:1";
+    auto* b =
+        benchmark::RegisterBenchmark(name.c_str(), [n](benchmark::State& st) { bm_seed(st, n); });
+    configure(b->Unit(benchmark::kMillisecond)->UseRealTime(), 0.3);
+  }
+}
+
+}  // namespace mmpm::bench
