@@ -18,7 +18,7 @@ template <int D, class Real>
 class MultimaterialStage {
  public:
   void setup(const Scene& scene, const FieldPlan& plan, const GridView<D, Real>& grid,
-             Real mass_threshold, double dt) {
+             Real min_particle_mass, double dt) {
     enabled_ = plan.multimaterial;
     fields_ = plan.fields;
     stats_.reset(plan.fields);
@@ -58,7 +58,7 @@ class MultimaterialStage {
     cfg_.thickness = D == 2 ? Real(scene.simulation.thickness) : Real(1);
     // Contact and interfaces ignore a material whose nodal mass is a sliver
     // (ALGORITHM §4.3): 1e-6 of the lightest particle, well above round-off.
-    cfg_.mass_threshold = mass_threshold * Real(1000);
+    cfg_.mass_threshold = min_particle_mass * Real(1e-6);
     cfg_.dt = Real(dt);
     if (const char* why = validate_multimaterial(grid, cfg_))
       throw InputError(scene.source_file + ": multimaterial setup: " + why);

@@ -170,6 +170,7 @@ class Stepper final : public Simulation {
   long step_ = 0;
   Real thickness_ = 1;
   Real mass_threshold_ = 0;
+  double min_particle_mass_ = 0;
   std::array<double, 3> gravity_{0, 0, 0};
   bool has_gravity_ = false, has_traction_ = false;
   bool domain_gradient_ = false;    // some interaction's normal needs g (P-33)
