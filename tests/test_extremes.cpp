@@ -272,8 +272,8 @@ TEST(Extremes, TranslationIsExactForEveryShape) {
     int dim;
     const char* shape;
   };
-  for (const Case c : {Case{2, "linear"}, Case{2, "gimp"}, Case{2, "bspline2"},
-                       Case{2, "bspline3"}, Case{3, "linear"}, Case{3, "gimp"}}) {
+  for (const Case c : {Case{2, "linear"}, Case{2, "gimp"}, Case{2, "bspline2"}, Case{2, "bspline3"},
+                       Case{3, "linear"}, Case{3, "gimp"}}) {
     const bool two = c.dim == 2;
     const std::string scene =
         std::string(two ? R"(
@@ -295,8 +295,8 @@ cfl = 0.5
 origin = [0.0, 0.0, 0.0]
 cell = [1.0, 1.0, 1.0]
 cells = [10, 10, 10]
-)") +
-        "shape = \"" + c.shape + R"("
+)") + "shape = \"" +
+        c.shape + R"("
 [[material]]
 name = "m"
 type = "isotropic"
@@ -306,9 +306,10 @@ nu = 0.3
 [[body]]
 material = "m"
 shape = "box"
-)" + (two ? "min = [3.0, 8.0]\nmax = [7.0, 11.0]\nvelocity = [3.0, -1.5]\n"
-          : "min = [3.0, 3.0, 5.0]\nmax = [6.0, 6.0, 8.0]\nvelocity = [1.0, 0.5, 0.0]\n"
-            "[[load]]\nkind = \"gravity\"\nacceleration = [0.0, 0.0, -9.81]\n");
+)" +
+        (two ? "min = [3.0, 8.0]\nmax = [7.0, 11.0]\nvelocity = [3.0, -1.5]\n"
+             : "min = [3.0, 3.0, 5.0]\nmax = [6.0, 6.0, 8.0]\nvelocity = [1.0, 0.5, 0.0]\n"
+               "[[load]]\nkind = \"gravity\"\nacceleration = [0.0, 0.0, -9.81]\n");
     auto sim = make_from_text(scene);
     run_until(*sim, two ? 0.06 : 0.2);
     const double t = sim->time();

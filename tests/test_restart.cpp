@@ -237,6 +237,10 @@ void check_killed_run_continues_bitwise(const std::string& scene_text) {
   const long ckpt_step = mmpm::io::read_scalar_blob<long>(mmpm::io::find_blob(blobs, "step"));
   EXPECT_GT(ckpt_step, 0);
   EXPECT_LT(ckpt_step, steps);
+  // ... and carries the wall time and stage times spent up to it.
+  const double ckpt_wall =
+      mmpm::io::read_scalar_blob<double>(mmpm::io::find_blob(blobs, "driver.wall_s"));
+  EXPECT_GT(ckpt_wall, 0.0);
 
   // 3. Restart and compare.
   const CmdResult again = run_mmpm({"run", "--restart", dir.string(), "--threads", "1", "--quiet"});
@@ -257,6 +261,14 @@ void check_killed_run_continues_bitwise(const std::string& scene_text) {
     EXPECT_EQ(got.at("energy").at(e).get<double>(), ref_summary.at("energy").at(e).get<double>())
         << e;
   EXPECT_EQ(got.at("multimaterial_nodes"), ref_summary.at("multimaterial_nodes"));
+  // The summary's times cover every step of the result, as its step count
+  // does: the segment before the checkpoint plus the resumed one (it took
+  // only the resumed segment, so ns_per_particle_step read low).
+  EXPECT_GT(got.at("wall_s").get<double>(), ckpt_wall);
+  double stages = 0;
+  for (const auto& [name, seconds] : got.at("stages_s").items()) stages += seconds.get<double>();
+  EXPECT_NEAR(stages, got.at("wall_s").get<double>(), 1e-9 * got.at("wall_s").get<double>())
+      << "stages_s (with other) add up to wall_s";
   EXPECT_GT(ref_summary.at("energy").at("interface").get<double>(), 0.0)
       << "the interface carries state";
 }

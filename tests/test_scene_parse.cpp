@@ -708,11 +708,11 @@ TEST(SceneParseErrors, WrongTypes) {
   expect_mutation_error("dimension = 2", "dimension = 2.0", "simulation.dimension",
                         {"expected an integer, got a floating-point number"});
   expect_mutation_error("cells = [20, 20]", "cells = [20, 20.5]", "grid.cells",
-                        {"integers", "entry 2"});
+                        {"integers", "element [1]"});
   expect_mutation_error("origin = [0.0, 0.0]", "origin = [0.0, 0.0, 0.0]", "grid.origin",
                         {"expected an array of 2 numbers", "got an array of 3"});
   expect_mutation_error("traction = [0.0, 0.5]", "traction = [0.0, \"up\"]", "load[0].traction",
-                        {"entry 2 is a string"});
+                        {"element [1] is a string"});
 }
 
 TEST(SceneParseErrors, SectionOfTheWrongKind) {
@@ -777,7 +777,7 @@ TEST(SceneParseErrors, GridValues) {
                         {"every cell size > 0", "[0.5, 0]"});
   expect_mutation_error("cell = [0.5, 0.5]", "cell = [-0.5, 0.5]", "grid.cell", {"> 0"});
   expect_mutation_error("cells = [20, 20]", "cells = [20, 0]", "grid.cells",
-                        {">= 1", "entry 2 is 0"});
+                        {">= 1", "element [1] is 0"});
 }
 
 TEST(SceneParseErrors, SimulationValues) {

@@ -19,6 +19,7 @@ int check_scene(const std::string& file, const std::vector<std::string>& sets) {
   auto sim = make_simulation(scene);  // builds particles: catches geometry errors
   std::cout << format_scene(scene);
   const double crit = critical_time_step(scene), dt = sim->dt();
+  check_step_count(scene, dt);
   std::cout << "# instantiation: " << sim->instantiation() << "\n"
             << "# particles: " << sim->particle_count() << ", nodes: " << sim->node_count()
             << ", material fields: " << sim->field_count() << ", tile: " << sim->tile_edge()
@@ -37,6 +38,17 @@ int check_scene(const std::string& file, const std::vector<std::string>& sets) {
 int main(int argc, char** argv) {
   CLI::App app{"mmpm: multimaterial material point method with contact and imperfect interfaces"};
   app.require_subcommand(1);
+  // CLI11 answers an unknown first word with "A subcommand is required".
+  if (argc > 1 && argv[1][0] != '-') {
+    const std::string cmd = argv[1];
+    if (cmd != "run" && cmd != "check" && cmd != "sweep" && cmd != "info") {
+      std::cerr << "mmpm: unknown command '" << cmd
+                << "'; expected run, check, sweep or info (mmpm --help)\n";
+      return 2;
+    }
+  }
+  // Thread and job counts: CLI::PositiveNumber's message printed DBL_MAX in full.
+  const CLI::Range kCount(1, 4096);
 
   auto* run = app.add_subcommand("run", "run a scene");
   std::string scene_file, restart_dir, out_dir;
@@ -46,7 +58,7 @@ int main(int argc, char** argv) {
   run->add_option("scene", scene_file, "scene file (TOML)");
   run->add_option("--restart", restart_dir, "continue the run in DIR from its last checkpoint");
   run->add_option("--out", out_dir, "output directory (default results/<scene name>)");
-  run->add_option("--threads", threads, "OpenMP threads")->check(CLI::PositiveNumber);
+  run->add_option("--threads", threads, "OpenMP threads")->check(kCount);
   run->add_option("--set", sets, "override a scene key: KEY=VALUE (TOML value)");
   run->add_flag("--quiet", quiet, "no progress line, no timing table");
   run->add_flag("--force", force, "run even when the time step exceeds the stability limit");
@@ -63,8 +75,9 @@ int main(int argc, char** argv) {
   sweep->add_option("scene", so.scene_file, "scene file (TOML)")->required();
   sweep->add_option("--param", so.param, "key to vary, as for --set")->required();
   sweep->add_option("--values", values, "comma-separated TOML values")->required();
-  sweep->add_option("--jobs", so.jobs, "runs at once")->check(CLI::PositiveNumber);
-  sweep->add_option("--threads", so.threads, "OpenMP threads per run (default cores / jobs)");
+  sweep->add_option("--jobs", so.jobs, "runs at once")->check(kCount);
+  sweep->add_option("--threads", so.threads, "OpenMP threads per run (default cores / jobs)")
+      ->check(kCount);
   sweep->add_option("--out", so.out, "output directory");
   sweep->add_option("--set", so.overrides, "override a scene key for every run");
   bool sweep_quiet = false;
@@ -87,6 +100,10 @@ int main(int argc, char** argv) {
     if (*check) return check_scene(check_file, check_sets);
     if (*sweep) {
       so.values = mmpm::split_values(values);
+      if (so.values.empty()) {
+        std::cerr << "mmpm sweep: --values: expected comma-separated TOML values, got none\n";
+        return 2;
+      }
       so.quiet = sweep_quiet;
       return mmpm::run_sweep(so);
     }

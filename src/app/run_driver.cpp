@@ -37,6 +37,12 @@ struct DriverState {
   long next_snapshot = 0;  // index k of the next snapshot time k * every
   long streak_start = -1;  // first step of the current run of low kinetic ratio
   long last_snapshot_step = -1;
+  // A restarted run's earlier segments, up to the checkpoint it resumed
+  // from: summary.json's wall_s and stages_s cover every step of the
+  // result, as its step count does (the minutes between that checkpoint
+  // and the kill were redone, and count once).
+  double wall_before = 0;
+  std::vector<double> stages_before = std::vector<double>(kStageCount, 0.0);
 };
 
 // Series names allow letters, digits, '_', '.', '-' (run.h5 dataset names).
@@ -106,8 +112,12 @@ void add_series_row(Simulation& sim, DriverState& st,
   for (std::size_t k = 0; k < row.size(); ++k) st.columns[k].push_back(row[k]);
 }
 
-std::vector<io::Blob> driver_blobs(const DriverState& st) {
+std::vector<io::Blob> driver_blobs(const DriverState& st, double wall_s,
+                                   const std::array<double, kStageCount>& stages_s) {
   std::vector<io::Blob> b;
+  b.push_back(io::make_scalar_blob("driver.wall_s", wall_s));
+  b.push_back(
+      io::make_blob("driver.stages_s", std::vector<double>(stages_s.begin(), stages_s.end())));
   b.push_back(io::make_scalar_blob("driver.next_snapshot", st.next_snapshot));
   b.push_back(io::make_scalar_blob("driver.streak_start", st.streak_start));
   b.push_back(io::make_scalar_blob("driver.last_snapshot_step", st.last_snapshot_step));
@@ -121,6 +131,15 @@ void load_driver_blobs(const std::vector<io::Blob>& blobs, DriverState& st) {
   st.streak_start = io::read_scalar_blob<long>(io::find_blob(blobs, "driver.streak_start"));
   st.last_snapshot_step =
       io::read_scalar_blob<long>(io::find_blob(blobs, "driver.last_snapshot_step"));
+  // Checkpoints written before 2026-11-26 carry no times: the summary then
+  // covers the resumed segment only, as it did.
+  for (const io::Blob& b : blobs) {
+    if (b.name == "driver.wall_s") st.wall_before = io::read_scalar_blob<double>(b);
+    if (b.name == "driver.stages_s") {
+      io::read_blob(b, st.stages_before);
+      st.stages_before.resize(kStageCount, 0.0);
+    }
+  }
   st.columns.assign(st.names.size(), {});
   for (std::size_t k = 0; k < st.names.size(); ++k)
     io::read_blob(io::find_blob(blobs, "driver.series." + std::to_string(k)), st.columns[k]);
@@ -175,10 +194,14 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
     const Where& w = scene.simulation.step_where;
     std::ostringstream m;
     m << "time step " << dt << " exceeds the stability limit " << crit << " (cfl " << dt / crit
-      << " > 1); lower it, or run with --force";
+      << " > 1";
+    if (crit == damping_time_step(scene))
+      m << "; the limit is 2 / grid.damping, of the damping " << scene.grid.damping;
+    m << "); lower it, or run with --force";
     throw InputError(located(w.file.empty() ? scene.source_file : w.file, w.line,
                              w.key.empty() ? "simulation.cfl" : w.key, m.str()));
   }
+  check_step_count(scene, dt);
   std::unique_ptr<Simulation> sim = make_simulation(scene);
   const int dim = scene.simulation.dimension;
   DriverState st;
@@ -212,7 +235,11 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
   auto sim_stages = [&] {
     auto s = sim->stage_seconds();
     s[kStageOutput] = stage_s[kStageOutput];
+    for (int k = 0; k < kStageCount; ++k) s[std::size_t(k)] += st.stages_before[std::size_t(k)];
     return s;
+  };
+  auto wall_so_far = [&] {
+    return st.wall_before + std::chrono::duration<double>(Clock::now() - wall0).count();
   };
   long output_calls = 0;
   auto snapshot_if_due = [&](bool final) {
@@ -230,7 +257,7 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
   auto checkpoint = [&] {
     const auto t0 = Clock::now();
     std::vector<io::Blob> blobs = sim->save_state();
-    for (auto& b : driver_blobs(st)) blobs.push_back(std::move(b));
+    for (auto& b : driver_blobs(st, wall_so_far(), sim_stages())) blobs.push_back(std::move(b));
     io::write_checkpoint(dir / "checkpoint.bin", blobs);
     stage_s[kStageOutput] += std::chrono::duration<double>(Clock::now() - t0).count();
   };
@@ -248,7 +275,7 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
   auto last_ckpt = Clock::now();
   try {
     while (sim->time() < end_time - 1e-9 * sim->dt()) {
-      sim->step();
+      sim->step_within(end_time);
       const long s = sim->step_count();
       bool stop = false;
       if (stop_check > 0 && s % stop_check == 0) {
@@ -290,7 +317,7 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
   writer->finish();
   fs::remove(dir / "checkpoint.bin");
 
-  const double wall = std::chrono::duration<double>(Clock::now() - wall0).count();
+  const double wall = wall_so_far();
   auto stages = sim_stages();
   auto calls = sim->stage_calls();
   calls[kStageOutput] = output_calls;

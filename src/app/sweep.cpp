@@ -87,7 +87,8 @@ int run_sweep(const SweepOptions& opt) {
   });
   std::ostringstream csv;
   csv << "index,value,status,steps,end_time,wall_s,ns_per_particle_step,kinetic,strain,interface,"
-         "external_work,damping,multimaterial_nodes,force_limited_nodes,stopped_by,directory\n";
+         "external_work,damping,multimaterial_nodes,force_limited_nodes,stopped_by,directory,"
+         "message\n";
   int code = 0;
   for (std::size_t k = 0; k < n; ++k) {
     const auto& r = results[k];
@@ -102,10 +103,12 @@ int run_sweep(const SweepOptions& opt) {
           << j["multimaterial_nodes"] << "," << j["force_limited_nodes"] << ","
           << j["stopped_by"].get<std::string>();
     } else {
-      csv << ",,,,,,,,,,,," << csv_quoted(r.message.substr(0, 200));
+      csv << ",,,,,,,,,,,";  // the 12 columns steps .. stopped_by, empty
       code = 3;
     }
-    csv << "," << (dir / std::to_string(k)).string() << "\n";
+    // The message last, so that every row has the header's columns.
+    csv << "," << (dir / std::to_string(k)).string() << ","
+        << (r.exit_code == 0 ? "" : csv_quoted(r.message.substr(0, 200))) << "\n";
   }
   io::write_file_atomic(dir / "sweep.csv", csv.str());
   if (!opt.quiet) std::cerr << "wrote " << (dir / "sweep.csv").string() << "\n";

@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <numbers>
+#include <string>
 #include <vector>
 
 #include "scene/error.hpp"
@@ -226,9 +227,10 @@ ParticleSeeds make_particles(const Scene& scene) {
                 ++added;
               }
     if (added == 0)
-      throw InputError(located(body.where.file, body.where.line, "shape",
-                               "body '" + body.name +
-                                   "' holds no particle on this grid "
+      throw InputError(located(body.where.file, body.where.line,
+                               "body[" + std::to_string(bi) + "].shape",
+                               "body \"" + body.name +
+                                   "\" holds no particle on this grid "
                                    "(smaller than a particle spacing, or outside the grid)"));
   }
   // Drop replaced particles, keeping the order.

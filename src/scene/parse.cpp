@@ -1,5 +1,7 @@
 #include "scene/parse.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
 #include <climits>
@@ -251,7 +253,7 @@ class Field {
     for (std::size_t k = 0; k < items.size(); ++k) {
       const toml::value& e = items[k].raw();
       if (!e.is_integer() && !e.is_floating()) {
-        fail("expected " + expected + "; entry " + std::to_string(k + 1) + " is " + type_name(e));
+        fail("expected " + expected + "; element [" + std::to_string(k) + "] is " + type_name(e));
       }
       fill[k] = items[k].number();
     }
@@ -395,6 +397,47 @@ std::optional<Bounds> body_bounds(const BodySpec& b, int dim) {
     }
   }
   return box;
+}
+
+// Area (2D) or volume of a body as filled, at most its clipped bounds'.
+double body_measure(const BodySpec& b, int dim, const Bounds& clipped) {
+  double shape = 0;
+  const double pi = std::acos(-1.0);
+  switch (b.shape) {
+    case BodyShape::box:
+      shape = 1;
+      for (std::size_t k = 0; k < static_cast<std::size_t>(dim); ++k) shape *= b.max[k] - b.min[k];
+      break;
+    case BodyShape::disk:
+      shape = pi * b.radius * b.radius;
+      break;
+    case BodyShape::sphere:
+      shape = 4.0 / 3.0 * pi * b.radius * b.radius * b.radius;
+      break;
+    case BodyShape::cylinder:
+      shape = pi * b.radius * b.radius * b.length;
+      break;
+    case BodyShape::polygon: {
+      double twice = 0;
+      for (std::size_t i = 0; i < b.points.size(); ++i) {
+        const Vec3& p = b.points[i];
+        const Vec3& q = b.points[(i + 1) % b.points.size()];
+        twice += p[0] * q[1] - q[0] * p[1];
+      }
+      shape = 0.5 * std::abs(twice);
+      break;
+    }
+  }
+  double box = 1;
+  for (std::size_t k = 0; k < static_cast<std::size_t>(dim); ++k)
+    box *= clipped.hi[k] - clipped.lo[k];
+  return std::min(shape, box);
+}
+
+// Bytes of RAM on this machine (0 when unknown: no check then).
+double physical_memory() {
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+  return pages > 0 && page > 0 ? double(pages) * double(page) : 0.0;
 }
 
 std::string bounds_text(const Bounds& b, int dim) {
@@ -611,9 +654,56 @@ class SceneReader {
       }
     }
     read_cells(t.need("cells"));
+    check_grid_memory(t.need("cells"));
     if (auto f = t.get("shape")) g.shape = f->choice(kShapeKindNames);
     if (auto f = t.get("damping")) g.damping = f->non_negative();
     if (auto f = t.get("tile")) g.tile = f->int_at_least(0);
+  }
+
+  // Sizes a run could never allocate are bad input, said before anything
+  // is allocated: a grid of 10^8 x 10^8 cells ended in std::bad_alloc
+  // (exit 3), and a body with 10^5 particles per cell and direction in a
+  // seeding loop that did not end. The counts are lower bounds of what the
+  // solver stores (the grid's m, p, f, vel, dvel of one field; a particle's
+  // position, velocity, start, mass, volume and stress), so a run refused
+  // here could not have run.
+  double real_bytes() const {
+    return scene_.simulation.precision == Precision::float64 ? 8.0 : 4.0;
+  }
+  void check_grid_memory(const Field& f) const {
+    double nodes = 1;
+    for (int k = 0; k < dim(); ++k) nodes *= double(scene_.grid.cells[std::size_t(k)]) + 1;
+    const double need = nodes * (1 + 4 * dim()) * real_bytes(), have = physical_memory();
+    if (have > 0 && need > have)
+      f.fail("the grid has " + number_text(nodes) + " nodes, at least " + gib_text(need) +
+             " for its arrays, more than this machine's memory (" + gib_text(have) +
+             "); expected fewer or larger cells");
+  }
+  void check_particle_memory(const Table& t, const BodySpec& b, const Bounds& clipped) {
+    double cell = 1;
+    for (int k = 0; k < dim(); ++k) cell *= scene_.grid.cell[std::size_t(k)];
+    particles_estimate_ +=
+        body_measure(b, dim(), clipped) / cell * std::pow(double(b.particles_per_cell), dim());
+    const double per_particle = (dim() == 2 ? 12 : 17) * real_bytes();
+    const double need = particles_estimate_ * per_particle, have = physical_memory();
+    if (have > 0 && need > have) {
+      const auto f = t.get("particles_per_cell");
+      const std::string why =
+          "the bodies up to this one hold about " + number_text(particles_estimate_) +
+          " particles, at least " + gib_text(need) + ", more than this machine's memory (" +
+          gib_text(have) + "); expected fewer particles per cell or smaller bodies";
+      if (f) f->fail(why);
+      t.need("shape").fail(why);
+    }
+  }
+  static std::string number_text(double x) {
+    std::ostringstream os;
+    os.precision(3);
+    os << x;
+    return os.str();
+  }
+  static std::string gib_text(double bytes) {
+    return number_text(bytes / double(1ull << 30)) + " GiB";
   }
 
   void read_cells(const Field& f) {
@@ -626,9 +716,9 @@ class SceneReader {
     for (std::size_t k = 0; k < items.size(); ++k) {
       const toml::value& e = items[k].raw();
       if (!e.is_integer())
-        f.fail("expected " + expected + "; entry " + std::to_string(k + 1) + " is " + type_name(e));
+        f.fail("expected " + expected + "; element [" + std::to_string(k) + "] is " + type_name(e));
       if (e.as_integer() < 1 || e.as_integer() > INT_MAX) {
-        f.fail("expected " + expected + "; entry " + std::to_string(k + 1) + " is " +
+        f.fail("expected " + expected + "; element [" + std::to_string(k) + "] is " +
                std::to_string(e.as_integer()));
       }
       scene_.grid.cells[k] = static_cast<int>(e.as_integer());
@@ -802,6 +892,7 @@ class SceneReader {
     }
     if (auto f = t.get("clip")) b.clip = read_box(f->table(), "clip box");
     check_inside_grid(t, b);
+    check_particle_memory(t, b, *body_bounds(b, dim()));
     scene_.bodies.push_back(std::move(b));
   }
 
@@ -868,7 +959,9 @@ class SceneReader {
       twice_area += p[0] * q[1] - q[0] * p[1];
     }
     if (twice_area == 0.0)
-      f.fail("expected a polygon enclosing some area (the points are collinear)");
+      f.fail(
+          "expected a polygon enclosing some area (the points are collinear, or the outline "
+          "crosses itself so that its parts' areas cancel)");
     return pts;
   }
 
@@ -1185,7 +1278,19 @@ class SceneReader {
     t.only({"every", "fields", "series", "checkpoint_minutes", "directory"});
     OutputSpec& o = scene_.output;
     if (auto f = t.get("every")) o.every = f->non_negative();
-    if (auto f = t.get("fields")) o.fields = output_fields(*f);
+    if (auto f = t.get("fields")) {
+      o.fields = output_fields(*f);
+      // F is kept only for finite-strain materials (the H columns); said
+      // here, where `check` sees it too, not when the first snapshot fails.
+      const bool finite =
+          std::any_of(scene_.materials.begin(), scene_.materials.end(),
+                      [](const MaterialSpec& m) { return m.type == MaterialType::neohookean; });
+      if (!finite &&
+          std::find(o.fields.begin(), o.fields.end(), "deformation_gradient") != o.fields.end())
+        f->fail(
+            "field \"deformation_gradient\" needs a finite-strain (\"neohookean\") material; "
+            "this scene has none (the small-strain types keep no F)");
+    }
     if (auto f = t.get("series")) o.series = f->int_at_least(1);
     if (auto f = t.get("checkpoint_minutes")) o.checkpoint_minutes = f->non_negative();
     o.directory = "results/" + scene_.name;
@@ -1221,6 +1326,7 @@ class SceneReader {
 
   const Source& src_;
   std::string default_name_;
+  double particles_estimate_ = 0;  // check_particle_memory, summed over the bodies
   const toml::value empty_ = toml::table{};
   Scene scene_;
 };
@@ -1298,8 +1404,10 @@ toml::value& descend(toml::value& table, const PathStep& step, const std::string
       override_fail(key, quote(step.key) + " is not an array of tables; drop the [i]");
     auto& arr = v.as_array();
     if (*step.index >= arr.size()) {
-      override_fail(key, "index " + std::to_string(*step.index) + " is out of range: there are " +
-                             std::to_string(arr.size()) + " [[" + step.key + "]] tables");
+      override_fail(
+          key, "index " + std::to_string(*step.index) + " is out of range: there " +
+                   (arr.size() == 1 ? "is 1 [[" : "are " + std::to_string(arr.size()) + " [[") +
+                   step.key + "]] table" + (arr.size() == 1 ? "" : "s"));
     }
     if (!arr[*step.index].is_table())
       override_fail(key, quote(step.key) + " is not an array of tables");
@@ -1378,6 +1486,11 @@ Scene parse_scene_text(const std::string& text, const std::string& file_label,
 }
 
 Scene parse_scene_file(const std::string& path, const std::vector<std::string>& overrides) {
+  // An ifstream opens a directory on Linux and reads it as empty, which
+  // would be reported as a scene missing its keys.
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec))
+    throw InputError(located(path, 0, "", "is a directory; expected a scene file (TOML)"));
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(located(path, 0, "", "cannot open the scene file"));
   std::ostringstream text;

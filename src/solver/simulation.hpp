@@ -65,6 +65,9 @@ class Simulation {
  public:
   virtual ~Simulation() = default;
   virtual void step() = 0;  // throws SimulationError
+  // One step, shortened to end at t_end when a whole one would pass it: a
+  // run's last step lands on its end_time (the step after stays dt()).
+  virtual void step_within(double t_end) = 0;
   virtual long step_count() const = 0;
   virtual double time() const = 0;
   virtual double dt() const = 0;
@@ -97,5 +100,9 @@ std::unique_ptr<Simulation> make_simulation(const Scene& scene);
 // Stable time step for the scene: cfl * min cell / (max wave speed + max body speed).
 double stable_time_step(const Scene& scene);
 double critical_time_step(const Scene& scene);  // the same with cfl = 1
+double damping_time_step(const Scene& scene);   // 2 / grid.damping (its own limit)
+// `run` and `check`: an end_time / dt beyond any run (1e12 steps) is bad
+// input. (The library steps on past end_time for as long as it is asked.)
+void check_step_count(const Scene& scene, double dt);
 
 }  // namespace mmpm

@@ -45,6 +45,7 @@ class Stepper final : public Simulation {
   explicit Stepper(const Scene& scene);
 
   void step() override;
+  void step_within(double t_end) override;
   long step_count() const override { return step_; }
   double time() const override { return time_; }
   double dt() const override { return dt_; }

@@ -900,6 +900,26 @@ void Stepper<D, Shape, Real>::step() {
   ++step_;
 }
 
+// Every stage reads dt_ when it runs and keeps nothing that depends on it
+// for the next step (the multimaterial pass takes it per call, the fused
+// tail's P2G does not use it), so one shortened step needs no other state.
+// time_ + (t_end - time_) is t_end exactly: the difference is exact
+// (Sterbenz) once time_ is within a step of t_end, and so is the sum.
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::step_within(double t_end) {
+  const double left = t_end - time_;
+  if (!(left > 0 && left < dt_)) return step();
+  const double regular = dt_;
+  dt_ = left;
+  try {
+    step();
+  } catch (...) {
+    dt_ = regular;
+    throw;
+  }
+  dt_ = regular;
+}
+
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::fail_particle(const char* stage, std::size_t p,
                                             const std::string& why) const {

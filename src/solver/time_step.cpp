@@ -1,13 +1,17 @@
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <sstream>
 
 #include "model/material.hpp"
+#include "scene/error.hpp"
 #include "solver/simulation.hpp"
 
 namespace mmpm {
 
 // ALGORITHM §2: explicit integration is stable for dt below the time a
-// dilatational wave needs to cross the smallest cell (moving bodies add their speed).
+// dilatational wave needs to cross the smallest cell (moving bodies add
+// their speed), and below 2 / grid.damping (damping_time_step).
 double critical_time_step(const Scene& scene) {
   const int dim = scene.simulation.dimension;
   double hmin = scene.grid.cell[0];
@@ -28,12 +32,60 @@ double critical_time_step(const Scene& scene) {
       vmax = std::max(vmax, std::sqrt(v2));
     }
   const double speed = c + vmax;
-  return speed > 0 ? hmin / speed : scene.simulation.end_time;
+  const double wave = speed > 0 ? hmin / speed : scene.simulation.end_time;
+  return std::min(wave, damping_time_step(scene));
+}
+
+// Grid damping p <- p + dt (f - alpha p) multiplies a free node's momentum
+// by 1 - alpha dt each step: it grows without bound once alpha dt > 2.
+double damping_time_step(const Scene& scene) {
+  const double alpha = scene.grid.damping;
+  return alpha > 0 ? 2.0 / alpha : std::numeric_limits<double>::infinity();
+}
+
+namespace {
+
+// More steps than any run can take: at a microsecond per step, 1e12 steps
+// are eleven days, and past 2^52 steps t + dt no longer moves t.
+constexpr double kMaxSteps = 1e12;
+
+// The message for a time step that is 0, not finite, or too small for
+// end_time (huge moduli, tiny densities), named at the key that set it:
+// left alone, dt = 0 ran forever and `check` printed a negative step count.
+[[noreturn]] void bad_time_step(const Scene& scene, double dt, double steps) {
+  const int dim = scene.simulation.dimension;
+  double c = 0;
+  std::string fastest;
+  for (const auto& m : scene.materials) {
+    const double cm = make_material(m, dim, scene.simulation.plane).wave_speed;
+    if (!(cm <= c)) c = cm, fastest = m.name;
+  }
+  std::ostringstream msg;
+  msg << "the time step is " << dt;
+  if (dt > 0 && std::isfinite(dt))
+    msg << ", so end_time / dt = " << steps << " steps; expected at most " << kMaxSteps;
+  else
+    msg << "; expected a positive time step";
+  if (!fastest.empty())
+    msg << " (the fastest wave speed, of material '" << fastest << "', is " << c
+        << "; check its modulus and density)";
+  const Where& w = scene.simulation.step_where;
+  throw InputError(located(w.file.empty() ? scene.source_file : w.file, w.line,
+                           w.key.empty() ? "simulation.cfl" : w.key, msg.str()));
+}
+
+}  // namespace
+
+void check_step_count(const Scene& scene, double dt) {
+  const double steps = scene.simulation.end_time / dt;
+  if (!(steps <= kMaxSteps)) bad_time_step(scene, dt, steps);
 }
 
 double stable_time_step(const Scene& scene) {
-  if (scene.simulation.dt) return *scene.simulation.dt;
-  return scene.simulation.cfl * critical_time_step(scene);
+  const double dt =
+      scene.simulation.dt ? *scene.simulation.dt : scene.simulation.cfl * critical_time_step(scene);
+  if (!(dt > 0 && std::isfinite(dt))) bad_time_step(scene, dt, 0);
+  return dt;
 }
 
 }  // namespace mmpm
