@@ -6,6 +6,9 @@
 // of the ratio in bench/RESULTS.md. The scene is parsed once, outside the
 // timer. Before 2026-11-26 every later body tested every particle seeded so
 // far (O(particles x bodies)); now only those in its bounding box's cells.
+// parse/disks:N times parse_scene_text of the same scenes, per body: it
+// was O(bodies^2) (toml11 counted lines from the file's start for each
+// body's location, and duplicate names were searched body by body).
 #include <string>
 
 #include "bench/bench_common.hpp"
@@ -70,6 +73,19 @@ void bm_seed(benchmark::State& state, int n) {
   state.counters["bodies"] = double(scene.bodies.size());
 }
 
+void bm_parse(benchmark::State& state, int n) {
+  const std::string text = disks_scene(n);
+  std::size_t bodies = 0;
+  for (auto _ : state) {
+    const Scene scene = parse_scene_text(text, "disks.toml");
+    bodies = scene.bodies.size();
+    keep(bodies);
+  }
+  // ns per item with 1000 items a body: microseconds per body.
+  set_ns_per_item(state, "us_per_body", double(bodies) * 1e3);
+  state.counters["bodies"] = double(bodies);
+}
+
 }  // namespace
 
 void register_seed() {
@@ -77,6 +93,12 @@ void register_seed() {
     const std::string name = "seed/disks:" + std::to_string(n * n) + "/threads:1";
     auto* b =
         benchmark::RegisterBenchmark(name.c_str(), [n](benchmark::State& st) { bm_seed(st, n); });
+    configure(b->Unit(benchmark::kMillisecond)->UseRealTime(), 0.3);
+  }
+  for (int n : {25, 100, 200}) {
+    const std::string name = "parse/disks:" + std::to_string(n * n) + "/threads:1";
+    auto* b =
+        benchmark::RegisterBenchmark(name.c_str(), [n](benchmark::State& st) { bm_parse(st, n); });
     configure(b->Unit(benchmark::kMillisecond)->UseRealTime(), 0.3);
   }
 }

@@ -711,6 +711,15 @@ def seed_section(R):
                      fmt(R.value("seed", "particles", disks=n, threads=1), 0), fmt(v),
                      ratio(v, base)])
     out.append(table(header, rows) if rows else "(no seed run in this set)")
+    out += ["", "Parsing the same scenes (`parse/disks:N`, parse_scene_text, µs per body): flat "
+            "in the number of bodies since 2026-11-26 (it was O(bodies²): toml11 counted the "
+            "lines from the file's start for each body's location).", ""]
+    rows = []
+    for n in (625, 10000, 40000):
+        v = R.value("parse", "us_per_body", disks=n, threads=1, stat="min")
+        if v is not None:
+            rows.append([str(n), fmt(R.value("parse", "bodies", disks=n, threads=1), 0), fmt(v, 2)])
+    out.append(table(["disks", "bodies", "µs per body"], rows) if rows else "(no parse run in this set)")
     return out
 
 

@@ -2,6 +2,7 @@
 // expected), --set overrides, and the resolved text round trip.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -10,6 +11,7 @@
 #include <initializer_list>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "scene/error.hpp"
 #include "scene/format.hpp"
@@ -980,6 +982,29 @@ TEST(SceneParseErrors, OutputAndStopValues) {
 }
 
 // ---------------------------------------------------------- overrides --
+
+// Lines deep in a long file: every [[body]]'s recorded line is its header's
+// (the parser's table of line starts, Source::place), and a duplicate name
+// after 400 bodies is found (an index of names) and blamed on its own line,
+// with the first definition's line.
+TEST(SceneParseErrors, LinesAndNamesInAFileOf400Bodies) {
+  std::string text = kBase;
+  std::vector<int> headers;
+  for (int k = 0; k < 400; ++k) {
+    const std::string table = "[[body]]\nname = \"disk" + std::to_string(k) + "\"\n";
+    text +=
+        "\n" + table + "material = \"a\"\nshape = \"disk\"\ncenter = [5.0, 5.0]\nradius = 0.6\n";
+    headers.push_back(line_of(text, table));
+  }
+  const Scene scene = parse_scene_text(text, kLabel);
+  ASSERT_EQ(scene.bodies.size(), 402u);
+  for (std::size_t k = 0; k < 400; ++k) EXPECT_EQ(scene.bodies[k + 2].where.line, headers[k]) << k;
+  const int lines_before = int(std::count(text.begin(), text.end(), '\n')) + 1;
+  const std::string bad = text + "\n[[body]]\nname = \"disk17\"\nmaterial = \"a\"\n" +
+                          "shape = \"disk\"\ncenter = [5.0, 5.0]\nradius = 0.6\n";
+  expect_error(bad, lines_before + 2, "body[402].name",
+               {"duplicate body name", "line " + std::to_string(headers[17])});
+}
 
 TEST(SceneParseOverrides, NumberStringArrayAndIndexedTable) {
   const Scene s =
