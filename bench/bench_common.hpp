@@ -128,6 +128,41 @@ inline const char* real_name() {
 template <int D>
 inline constexpr int kDefaultTile = D == 2 ? 16 : 8;
 
+// ---------------------------------------------------------------- scenes
+// The 2D uGIMP scenes' simulation and grid: 254 x 254 cells of 1 mm.
+inline constexpr const char* kGimp2DHeader = R"(
+[simulation]
+dimension = 2
+plane     = "strain"
+thickness = 1.0
+end_time  = 1.0
+cfl       = 0.4
+
+[grid]
+origin = [0.0, 0.0]
+cell   = [1.0, 1.0]
+cells  = [254, 254]
+shape  = "gimp"
+)";
+
+// The particle-filled polymer's two materials (bench_step's 625 disks,
+// bench_seed's blocks of disks).
+inline constexpr const char* kPolymerAndGlass = R"(
+[[material]]
+name    = "polymer"
+type    = "isotropic"
+density = 1.2e-3
+E       = 2400.0
+nu      = 0.33
+
+[[material]]
+name    = "glass"
+type    = "isotropic"
+density = 2.5e-3
+E       = 70000.0
+nu      = 0.22
+)";
+
 // ---------------------------------------------------------------- counters
 // ns_per_particle = (time per iteration) / particles, as a rate counter: the
 // value particles * 1e-9 per iteration, divided by the (real or manual) time

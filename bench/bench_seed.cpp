@@ -19,31 +19,7 @@ namespace mmpm::bench {
 namespace {
 
 std::string disks_scene(int n) {
-  std::string s = R"(
-[simulation]
-dimension = 2
-end_time  = 1.0
-
-[grid]
-origin = [0.0, 0.0]
-cell   = [1.0, 1.0]
-cells  = [254, 254]
-shape  = "gimp"
-
-[[material]]
-name    = "polymer"
-type    = "isotropic"
-density = 1.2e-3
-E       = 2400.0
-nu      = 0.33
-
-[[material]]
-name    = "glass"
-type    = "isotropic"
-density = 2.5e-3
-E       = 70000.0
-nu      = 0.22
-
+  std::string s = std::string(kGimp2DHeader) + kPolymerAndGlass + R"(
 [[body]]
 material = "polymer"
 shape    = "box"

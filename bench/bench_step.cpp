@@ -76,22 +76,6 @@ where = { x = 2.0 }
 fix   = ["x"]
 )";
 
-// The 2D uGIMP scenes' simulation and grid: 254 x 254 cells of 1 mm.
-const char* kGimp2DHeader = R"(
-[simulation]
-dimension = 2
-plane     = "strain"
-thickness = 1.0
-end_time  = 1.0
-cfl       = 0.4
-
-[grid]
-origin = [0.0, 0.0]
-cell   = [1.0, 1.0]
-cells  = [254, 254]
-shape  = "gimp"
-)";
-
 // The two-layer family: `right_material` names the right box's material;
 // `second_material` adds layer_b; `interaction` adds the interface.
 std::string two_layer(bool second_material, bool interaction) {
@@ -160,22 +144,7 @@ traction = [0.0, 0.5]
 // interface: the case where the multimaterial fields are best scattered
 // with the first P2G ([simulation] mm_fields_share).
 std::string inclusions_scene() {
-  std::string s = std::string(kGimp2DHeader) + R"(
-
-[[material]]
-name    = "polymer"
-type    = "isotropic"
-density = 1.2e-3
-E       = 2400.0
-nu      = 0.33
-
-[[material]]
-name    = "glass"
-type    = "isotropic"
-density = 2.5e-3
-E       = 70000.0
-nu      = 0.22
-
+  std::string s = std::string(kGimp2DHeader) + kPolymerAndGlass + R"(
 [[body]]
 name     = "block"
 material = "polymer"
