@@ -266,7 +266,8 @@ velocity = [12.0, 0.0]
 // (products of two or three small 1D weights); the mass threshold at 1e-9
 // of a particle's mass dropped them while their weight gradients were
 // ~1e-8 / h, and uGIMP's velocity error grew to 1.7e-8 (2D) and 2.4e-6 (3D
-// free fall), its stress to 4e-7 E. At 1e-15: 1.2e-15 and 3.5e-12.
+// free fall), its stress to 4.3e-10 E and 8.5e-9 E. At 1e-15: velocity
+// 1.2e-15 and 3.5e-12, stress 8e-18 E and 1.4e-14 E.
 TEST(Extremes, TranslationIsExactForEveryShape) {
   struct Case {
     int dim;
