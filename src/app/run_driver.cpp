@@ -191,15 +191,13 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
   const double crit = critical_time_step(scene);
   const double dt = stable_time_step(scene);
   if (dt > crit * (1 + 1e-12) && !(opt.force || scene.simulation.force)) {
-    const Where& w = scene.simulation.step_where;
     std::ostringstream m;
     m << "time step " << dt << " exceeds the stability limit " << crit << " (cfl " << dt / crit
       << " > 1";
     if (crit == damping_time_step(scene))
       m << "; the limit is 2 / grid.damping, of the damping " << scene.grid.damping;
     m << "); lower it, or run with --force";
-    throw InputError(located(w.file.empty() ? scene.source_file : w.file, w.line,
-                             w.key.empty() ? "simulation.cfl" : w.key, m.str()));
+    fail_at_time_step_key(scene, m.str());
   }
   check_step_count(scene, dt);
   std::unique_ptr<Simulation> sim = make_simulation(scene);

@@ -96,14 +96,15 @@ std::pair<Vec3, Vec3> bounds(const BodySpec& b, int dim) {
 // earlier bodies' particles by a later body (make_particles).
 class SeedCells {
  public:
-  SeedCells(const GridSpec& g, int dim, bool needed) : needed_(needed) {
-    if (!needed_) return;
+  // needed = false (a single body): no lists, and the calls do nothing.
+  SeedCells(const GridSpec& g, int dim, bool needed) {
+    if (!needed) return;
     for (int d = 0; d < 3; ++d) n_[d] = d < dim ? std::size_t(g.cells[d]) : 1;
     head_.assign(n_[0] * n_[1] * n_[2], kNone);
   }
   // Particle p, seeded in cell c.
   void add(std::size_t p, std::array<int, 3> c) {
-    if (!needed_) return;
+    if (head_.empty()) return;
     const std::size_t k = index(c);
     next_.resize(p + 1, kNone);
     next_[p] = head_[k];
@@ -113,7 +114,7 @@ class SeedCells {
   // by one cell on each side within the grid.
   template <class F>
   void for_each_in(std::array<int, 3> c0, std::array<int, 3> c1, int dim, F&& f) const {
-    if (!needed_) return;
+    if (head_.empty()) return;
     for (int d = 0; d < dim; ++d) {
       c0[d] = std::max(0, c0[d] - 1);
       c1[d] = std::min(int(n_[d]) - 1, c1[d] + 1);
@@ -129,7 +130,6 @@ class SeedCells {
   std::size_t index(std::array<int, 3> c) const {
     return (std::size_t(c[2]) * n_[1] + std::size_t(c[1])) * n_[0] + std::size_t(c[0]);
   }
-  bool needed_;
   std::size_t n_[3] = {1, 1, 1};
   std::vector<std::size_t> head_, next_;
 };

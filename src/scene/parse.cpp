@@ -426,6 +426,17 @@ std::optional<Bounds> body_bounds(const BodySpec& b, int dim) {
   return box;
 }
 
+// Twice the signed area of a polygon (shoelace formula).
+double polygon_twice_area(const std::vector<Vec3>& pts) {
+  double twice = 0;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const Vec3& p = pts[i];
+    const Vec3& q = pts[(i + 1) % pts.size()];
+    twice += p[0] * q[1] - q[0] * p[1];
+  }
+  return twice;
+}
+
 // Area (2D) or volume of a body as filled, at most its clipped bounds'.
 double body_measure(const BodySpec& b, int dim, const Bounds& clipped) {
   double shape = 0;
@@ -444,16 +455,9 @@ double body_measure(const BodySpec& b, int dim, const Bounds& clipped) {
     case BodyShape::cylinder:
       shape = pi * b.radius * b.radius * b.length;
       break;
-    case BodyShape::polygon: {
-      double twice = 0;
-      for (std::size_t i = 0; i < b.points.size(); ++i) {
-        const Vec3& p = b.points[i];
-        const Vec3& q = b.points[(i + 1) % b.points.size()];
-        twice += p[0] * q[1] - q[0] * p[1];
-      }
-      shape = 0.5 * std::abs(twice);
+    case BodyShape::polygon:
+      shape = 0.5 * std::abs(polygon_twice_area(b.points));
       break;
-    }
   }
   double box = 1;
   for (std::size_t k = 0; k < static_cast<std::size_t>(dim); ++k)
@@ -979,13 +983,7 @@ class SceneReader {
     std::vector<Vec3> pts;
     for (const Field& e : f.elements("an array of [x, y] points")) pts.push_back(e.vec(2));
     if (pts.size() < 3) f.fail("expected at least 3 points, got " + std::to_string(pts.size()));
-    double twice_area = 0;
-    for (std::size_t i = 0; i < pts.size(); ++i) {
-      const Vec3& p = pts[i];
-      const Vec3& q = pts[(i + 1) % pts.size()];
-      twice_area += p[0] * q[1] - q[0] * p[1];
-    }
-    if (twice_area == 0.0)
+    if (polygon_twice_area(pts) == 0.0)
       f.fail(
           "expected a polygon enclosing some area (the points are collinear, or the outline "
           "crosses itself so that its parts' areas cancel)");

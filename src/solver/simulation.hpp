@@ -104,5 +104,7 @@ double damping_time_step(const Scene& scene);   // 2 / grid.damping (its own lim
 // `run` and `check`: an end_time / dt beyond any run (1e12 steps) is bad
 // input. (The library steps on past end_time for as long as it is asked.)
 void check_step_count(const Scene& scene, double dt);
+// An InputError at the key that set the time step (simulation.dt or .cfl).
+[[noreturn]] void fail_at_time_step_key(const Scene& scene, const std::string& message);
 
 }  // namespace mmpm

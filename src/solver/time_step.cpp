@@ -2,12 +2,31 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <string>
 
 #include "model/material.hpp"
 #include "scene/error.hpp"
 #include "solver/simulation.hpp"
 
 namespace mmpm {
+namespace {
+
+// The fastest dilatational wave among the materials, and whose it is.
+struct FastestWave {
+  double speed = 0;
+  std::string material;
+};
+FastestWave fastest_wave(const Scene& scene) {
+  FastestWave f;
+  for (const auto& m : scene.materials) {
+    const double c =
+        make_material(m, scene.simulation.dimension, scene.simulation.plane).wave_speed;
+    if (c > f.speed) f.speed = c, f.material = m.name;
+  }
+  return f;
+}
+
+}  // namespace
 
 // ALGORITHM §2: explicit integration is stable for dt below the time a
 // dilatational wave needs to cross the smallest cell (moving bodies add
@@ -16,9 +35,7 @@ double critical_time_step(const Scene& scene) {
   const int dim = scene.simulation.dimension;
   double hmin = scene.grid.cell[0];
   for (int d = 1; d < dim; ++d) hmin = std::min(hmin, scene.grid.cell[d]);
-  double c = 0;
-  for (const auto& m : scene.materials)
-    c = std::max(c, make_material(m, dim, scene.simulation.plane).wave_speed);
+  const double c = fastest_wave(scene).speed;
   double vmax = 0;
   for (const auto& b : scene.bodies) {
     double v2 = 0;
@@ -53,28 +70,26 @@ constexpr double kMaxSteps = 1e12;
 // end_time (huge moduli, tiny densities), named at the key that set it:
 // left alone, dt = 0 ran forever and `check` printed a negative step count.
 [[noreturn]] void bad_time_step(const Scene& scene, double dt, double steps) {
-  const int dim = scene.simulation.dimension;
-  double c = 0;
-  std::string fastest;
-  for (const auto& m : scene.materials) {
-    const double cm = make_material(m, dim, scene.simulation.plane).wave_speed;
-    if (!(cm <= c)) c = cm, fastest = m.name;
-  }
+  const FastestWave fastest = fastest_wave(scene);
   std::ostringstream msg;
   msg << "the time step is " << dt;
   if (dt > 0 && std::isfinite(dt))
     msg << ", so end_time / dt = " << steps << " steps; expected at most " << kMaxSteps;
   else
     msg << "; expected a positive time step";
-  if (!fastest.empty())
-    msg << " (the fastest wave speed, of material '" << fastest << "', is " << c
-        << "; check its modulus and density)";
-  const Where& w = scene.simulation.step_where;
-  throw InputError(located(w.file.empty() ? scene.source_file : w.file, w.line,
-                           w.key.empty() ? "simulation.cfl" : w.key, msg.str()));
+  if (!fastest.material.empty())
+    msg << " (the fastest wave speed, of material '" << fastest.material << "', is "
+        << fastest.speed << "; check its modulus and density)";
+  fail_at_time_step_key(scene, msg.str());
 }
 
 }  // namespace
+
+void fail_at_time_step_key(const Scene& scene, const std::string& message) {
+  const Where& w = scene.simulation.step_where;
+  throw InputError(located(w.file.empty() ? scene.source_file : w.file, w.line,
+                           w.key.empty() ? "simulation.cfl" : w.key, message));
+}
 
 void check_step_count(const Scene& scene, double dt) {
   const double steps = scene.simulation.end_time / dt;
