@@ -373,15 +373,19 @@ struct Binning {
   std::vector<std::uint8_t> scratch_bytes;
   std::vector<std::uint32_t> scratch_keys;
 
+  std::array<Real, 3> origin{};  // key_origins of the grid (kernels/shape.hpp)
+
+  template <class Shape>
   void setup(int tile_edge, const GridView<D, Real>& G) {
     std::array<int, 3> cells{1, 1, 1};
     for (int d = 0; d < D; ++d) cells[d] = G.nodes_per_dim[d] - 1;
     tiles.setup(tile_edge, cells);
+    origin = key_origins<D, Shape>(G.origin, G.h);
   }
   std::uint32_t key_of(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
                        std::size_t p) const {
     std::array<int, 3> c{0, 0, 0};
-    for (int d = 0; d < D; ++d) c[d] = cell_of(P.x[d][p], G.origin[d], Real(1) / G.h[d]);
+    for (int d = 0; d < D; ++d) c[d] = cell_of(P.x[d][p], origin[d], Real(1) / G.h[d]);
     return tiles.key(c);
   }
   void compute_keys(ParticleSet<D, Real>& S, const GridView<D, Real>& G) const {

@@ -37,7 +37,7 @@ G2PFixture<D, Shape, Real>& g2p_fixture() {
     auto fx = std::make_unique<F>();
     make_block<D, Real>(fx->S, g2p_block<D>(std::is_same_v<Shape, GimpShape>));
     fx->grid.setup(g2p_cells<D>(), 1, false, true);
-    fx->bins.setup(kDefaultTile<D>, fx->grid.G);
+    fx->bins.template setup<Shape>(kDefaultTile<D>, fx->grid.G);
     fx->bins.sort(fx->S, fx->grid.G);
     // Small smooth grid velocities: particles drift by ~1e-6 cell per iteration.
     const GridView<D, Real>& G = fx->grid.G;
@@ -73,7 +73,7 @@ void bm_g2p(benchmark::State& state, int threads) {
   constexpr unsigned What = kUpdateMotion | kVelocityGradient;
   const G2PParams q = g2p_bench_params();
   // The tile-change test as the Stepper runs it (its KeyFn).
-  const auto key_of = PositionTile<D, Real>::of(fx.bins.tiles, G.origin, G.h, P.x);
+  const auto key_of = PositionTile<D, Real>::of(fx.bins.tiles, fx.bins.origin, G.h, P.x);
   const std::size_t n = P.n, chunks = chunk_count(n);
   std::vector<G2PRangeResult> res(chunks);
   for (auto _ : state) {
@@ -117,7 +117,7 @@ void bm_g2p_fused(benchmark::State& state, int threads) {
   const GridVelocity<D, Real>& V = fx.grid.V;
   constexpr unsigned What = kUpdateMotion | kScatterMomentum;
   const G2PParams q = g2p_bench_params();
-  const auto key_of = PositionTile<D, Real>::of(fx.bins.tiles, G.origin, G.h, P.x);
+  const auto key_of = PositionTile<D, Real>::of(fx.bins.tiles, fx.bins.origin, G.h, P.x);
   std::size_t bad = SIZE_MAX;
   for (auto _ : state) {
     for (int d = 0; d < D; ++d) std::fill(G.p[d], G.p[d] + G.nodes, Real(0));

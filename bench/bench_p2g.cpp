@@ -69,7 +69,7 @@ P2GFixture<D, Shape, Real>& p2g_fixture(int tile) {
     auto fx = std::make_unique<F>();
     make_block<D, Real>(fx->S, p2g_block<D>(std::is_same_v<Shape, GimpShape>));
     fx->grid.setup(p2g_cells<D>(), 1, false, false);
-    fx->bins.setup(tile, fx->grid.G);
+    fx->bins.template setup<Shape>(tile, fx->grid.G);
     fx->bins.sort(fx->S, fx->grid.G);
     for (std::size_t p = 0; p < fx->S.P.n; ++p) fx->total_mass += double(fx->S.P.m[p]);
     return fx;

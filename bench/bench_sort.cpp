@@ -39,7 +39,7 @@ SortFixture<D, Real>& sort_fixture() {
     make_block<D, Real>(fx->S, b);
     fx->grid.setup(D == 2 ? std::array<int, 3>{254, 254, 1} : std::array<int, 3>{36, 36, 36}, 1,
                    false, false);
-    fx->bins.setup(kDefaultTile<D>, fx->grid.G);
+    fx->bins.template setup<GimpShape>(kDefaultTile<D>, fx->grid.G);
     // A random order of the same particles, kept as the restore source.
     const std::size_t n = fx->S.P.n;
     std::vector<std::uint32_t> order(n);

@@ -175,13 +175,14 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
       Windowed ? Window<D, Shape, Real>::offsets(G) : typename Window<D, Shape, Real>::Offsets{};
   using Weights = typename G2PGather<D, Shape, Real, Windowed>::Weights;
   // When the momentum block and the gather's sums (2D vectors) do not fit in
-  // the registers together (3D uGIMP and B-splines in double: 24 + 6), the
+  // the registers together (3D uGIMP and B-splines in double: 27 + 6), the
   // momenta of a batch are scattered after its gathers, by GroupedScatter
   // (kernels/window_block.hpp), from the same windows: the same sums in the
   // same order. A particle off the grid ends the batch's scatter there (the
   // step fails on it anyway).
   constexpr int kUnits = Window<D, Shape, Real>::units;
-  constexpr bool kDefer = kScatter && Windowed && D * kUnits + 2 * D > kBlockRegisterBudget;
+  constexpr bool kDefer =
+      kScatter && Windowed && D * kUnits + 2 * D > block_register_budget<D, Shape, Real>();
   constexpr int kDeferUG = block_group_units<D, Shape, Real, kMomentumOnly, false>();
   struct NoDeferred {
     explicit NoDeferred(const GridView<D, Real>&) {}

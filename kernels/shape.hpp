@@ -9,6 +9,7 @@
 //    all window nodes of all directions in one call.
 #pragma once
 
+#include <array>
 #include <cmath>
 
 #include "kernels/lanes.hpp"
@@ -20,6 +21,7 @@ struct LinearShape {
   static constexpr int S = 2;
   static constexpr int W = 2;          // window nodes per direction (kernels/window.hpp)
   static constexpr int window_lo = 0;  // window starts at cell - window_lo
+  static constexpr bool nearest_node_stencil = false;  // kernels/shape.hpp key_origin
   static constexpr const char* name = "linear";
   template <class Real>
   static int eval(Real xi, Real /*half_width*/, Real* w, Real* dw) {
@@ -50,11 +52,14 @@ struct LinearShape {
 // stencil evaluation does not mispredict as particles move.
 struct GimpShape {
   static constexpr int S = 3;
-  // The window covers every stencil of a particle in one cell: nodes
-  // cell-1 .. cell+2. node() is zero beyond the particle's reach, so the
+  // The window covers every stencil of a particle of one key cell: nodes
+  // key-1 .. key+2. node() is zero beyond the particle's reach, so the
   // window weights need no padding logic.
   static constexpr int W = 4;
   static constexpr int window_lo = 1;
+  // The stencil is the nodes k-1 .. k+1 around the nearest node k
+  // (binned_by_nearest_node below).
+  static constexpr bool nearest_node_stencil = true;
   static constexpr const char* name = "gimp";
   template <class Real>
   static Real clamp1(Real s) {
@@ -94,6 +99,7 @@ struct BSpline2Shape {
   static constexpr int S = 3;
   static constexpr int W = 4;  // as uGIMP: nodes cell-1 .. cell+2
   static constexpr int window_lo = 1;
+  static constexpr bool nearest_node_stencil = true;  // as uGIMP
   static constexpr const char* name = "bspline2";
   template <class Real>
   static int eval(Real xi, Real /*half_width*/, Real* w, Real* dw) {
@@ -129,6 +135,7 @@ struct BSpline3Shape {
   static constexpr int S = 4;
   static constexpr int W = 4;  // the stencil itself: nodes cell-1 .. cell+2
   static constexpr int window_lo = 1;
+  static constexpr bool nearest_node_stencil = false;
   static constexpr const char* name = "bspline3";
   template <class Real>
   static int eval(Real xi, Real /*half_width*/, Real* w, Real* dw) {
@@ -164,5 +171,33 @@ struct BSpline3Shape {
     dw[3] = Real(0.5) * q3 * q3;
   }
 };
+
+// Whether particles are binned by their nearest node k instead of their
+// cell: then every particle of a bin has the stencil k-1 .. k+1, and the
+// window needs 3 rows per y and z direction instead of 4
+// (kernels/window.hpp). Only in 3D double, where it saves 28 of 64 window
+// nodes (P2G -16..-22 %, G2P -12 %); in 2D double 3 rows of 4 doubles take
+// three half-register units where 4 rows take two full ones, and in float
+// 3 rows of 16 bytes fill no register (docs/performance.md "Windows centred
+// on the nearest node").
+template <int D, class Shape, class Real>
+inline constexpr bool binned_by_nearest_node = Shape::nearest_node_stencil&& D == 3 &&
+                                               sizeof(Real) == 8;
+
+// The origin particles are binned from: the grid's, or half a cell below it
+// when binned by the nearest node, so that cell_of(x, key_origin, 1/h)
+// (kernels/binning.hpp) is that node. The window builder (kernels/window.hpp)
+// measures from the same origin, so a particle's window and its key agree
+// to the last bit.
+template <int D, class Shape, class Real>
+inline Real key_origin(Real origin, Real h) {
+  return binned_by_nearest_node<D, Shape, Real> ? origin - Real(0.5) * h : origin;
+}
+template <int D, class Shape, class Real>
+inline std::array<Real, 3> key_origins(const std::array<Real, 3>& origin,
+                                       const std::array<Real, 3>& h) {
+  return {key_origin<D, Shape>(origin[0], h[0]), key_origin<D, Shape>(origin[1], h[1]),
+          key_origin<D, Shape>(origin[2], h[2])};
+}
 
 }  // namespace mmpm

@@ -3,11 +3,14 @@
 // only around multimaterial nodes (docs/performance.md, "Multimaterial
 // fields where they are read").
 //
-// A particle in cell c has nonzero weights only on nodes c - lo .. c + hi,
-// lo = Shape::window_lo, hi = Shape::W - 1 - lo (its stencil lies inside
-// its window, kernels/window.hpp): linear 0/1, the others 1/2. So node i
-// receives from cells i - hi .. i + lo only, and a tile from cells
-// [t0, t1) reaches nodes t0 - lo .. t1 - 1 + hi.
+// A particle of key cell c (its cell, or its nearest node when binned so:
+// kernels/shape.hpp binned_by_nearest_node) has nonzero weights only on
+// nodes c - lo .. c + hi, lo = Shape::window_lo, hi = Shape::W - 1 - lo
+// (its stencil lies inside its window, kernels/window.hpp): linear 0/1,
+// the others 1/2 (binned by the nearest node: weights on c - 1 .. c + 1,
+// and the window's rows along x write zeros to c + 2). So node i receives
+// from cells i - hi .. i + lo only, and a tile from cells [t0, t1) reaches
+// nodes t0 - lo .. t1 - 1 + hi.
 #pragma once
 
 #include <algorithm>

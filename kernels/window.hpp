@@ -2,7 +2,7 @@
 // (ALGORITHM §1: S_ip, G_ip as tensor products of 1D weights).
 //
 // Why a window and not the particle's own stencil: every particle of one
-// cell gets the same window (nodes cell - window_lo .. + W - 1), so
+// key cell gets the same window (nodes key - window_lo .. + W - 1), so
 //  - P2G adds a whole cell's particles into a small local block and writes
 //    the block to the grid once per cell (kernels/window_block.hpp): the
 //    grid sees one read-modify-write per node and cell instead of one per
@@ -19,6 +19,13 @@
 // evaluates every window node). Near the grid's edge the window is shifted
 // inward, so it never leaves the grid; a particle whose own stencil leaves
 // the grid is rejected as before.
+//
+// The key cell is the particle's cell, or in 3D double, for the shapes
+// whose stencil is the 3 nodes around the nearest node (uGIMP, quadratic
+// B-spline), that node k: the cell of x + h/2 (kernels/shape.hpp
+// binned_by_nearest_node, key_origin). The window then has WY = 3 rows per
+// y and z direction instead of 4 (36 window nodes, not 64); x keeps W = 4
+// lanes, one 256-bit vector per row, the fourth lane's weight 0.
 //
 // Per unit u the kernels use lane vectors X (x weights), GX (x derivatives)
 // and Y(u), GY(u), GZ(u) such that, lane by lane,
@@ -37,6 +44,7 @@
 #include "kernels/grid_view.hpp"
 #include "kernels/lanes.hpp"
 #include "kernels/particle_view.hpp"
+#include "kernels/shape.hpp"
 #include "kernels/weight_batch.hpp"
 
 namespace mmpm {
@@ -57,13 +65,23 @@ template <int N, class F>
   static_for_each(f, std::make_integer_sequence<int, N>{});
 }
 
+// Rows per unit: the most that fill at most `cap` (64 bytes' worth) and
+// divide the rows evenly, as a power of two (vector lanes are).
+constexpr int window_rows_per_unit(int rows, int cap) {
+  int ru = 1;
+  while (2 * ru <= cap && 2 * ru <= rows && rows % (2 * ru) == 0) ru *= 2;
+  return ru;
+}
+
 template <int D, class Shape, class Real>
 struct Window {
-  static constexpr int W = Shape::W;
-  static constexpr int N = D == 2 ? W * W : W * W * W;  // window nodes
-  static constexpr int R = N / W;                       // rows of W nodes along x
-  static constexpr int RU = std::min<int>(R, 64 / int(W * sizeof(Real)));  // rows per unit
-  static constexpr int L = W * RU;                                         // lanes per unit
+  static constexpr int W = Shape::W;  // nodes per row (x)
+  // Rows per y and z direction (header comment).
+  static constexpr int WY = binned_by_nearest_node<D, Shape, Real> ? 3 : W;
+  static constexpr int N = D == 2 ? W * WY : W * WY * WY;  // window nodes
+  static constexpr int R = N / W;                          // rows of W nodes along x
+  static constexpr int RU = window_rows_per_unit(R, 64 / int(W * sizeof(Real)));  // rows per unit
+  static constexpr int L = W * RU;                                                // lanes per unit
   static constexpr int units = R / RU;
   // All directions' 1D weights in one vector (lane d * W + k: direction d,
   // node k), so the shape function runs once per particle, not once per
@@ -81,21 +99,24 @@ struct Window {
   VA wa;             // 1D weights, lane d * W + k
   VA dwa;            // 1D derivatives, already divided by h
 
-  // Every grid direction must hold a whole window (W nodes); else the caller
-  // uses the pointwise kernels.
+  // Nodes of the window along direction d.
+  static constexpr int extent(int d) { return d == 0 ? W : WY; }
+
+  // Every grid direction must hold a whole window; else the caller uses the
+  // pointwise kernels.
   static bool fits(const GridView<D, Real>& G) {
     for (int d = 0; d < D; ++d)
-      if (G.nodes_per_dim[d] < W) return false;
+      if (G.nodes_per_dim[d] < extent(d)) return false;
     return true;
   }
 
-  // Offsets from base of the rows (row r: y index r % W, z index r / W).
+  // Offsets from base of the rows (row r: y index r % WY, z index r / WY).
   static Offsets offsets(const GridView<D, Real>& G) {
     Offsets off{};
     const std::size_t nx = std::size_t(G.nodes_per_dim[0]);
     const std::size_t nxy = nx * std::size_t(G.nodes_per_dim[1]);
     for (std::size_t r = 0; r < off.size(); ++r)
-      off[r] = nx * (r % std::size_t(W)) + nxy * (r / std::size_t(W));
+      off[r] = nx * (r % std::size_t(WY)) + nxy * (r / std::size_t(WY));
     return off;
   }
 
@@ -146,11 +167,11 @@ struct Window {
   // Product of the y factor (from ya) and the z factor (from za) of unit u.
   template <int u>
   static V yz(const VA& ya, const VA& za) {
-    constexpr auto jy = [](int k) { return W + (u * RU + k / W) % W; };
+    constexpr auto jy = [](int k) { return W + (u * RU + k / W) % WY; };
     if constexpr (D == 2) {
       return pick(ya, jy);
     } else {
-      constexpr auto lz = [](int k) { return 2 * W + (u * RU + k / W) / W; };
+      constexpr auto lz = [](int k) { return 2 * W + (u * RU + k / W) / WY; };
       return pick(ya, jy) * pick(za, lz);
     }
   }
@@ -196,15 +217,18 @@ class WindowBuilder {
 
   // Lowest xi the stencil allows, and the margin it needs above: linear
   // [0, n - 1), uGIMP and quadratic [1/2, n - 3/2) (stencil base
-  // floor(xi - 1/2)), cubic [1, n - 2).
+  // floor(xi - 1/2)), cubic [1, n - 2). Centred shapes measure xi from
+  // their key origin, half a cell lower (xi + 1/2 in [1, n - 1)).
   static constexpr Real kLoXi = Shape::W == 2 ? Real(0) : (Shape::S == 3 ? Real(0.5) : Real(1));
   static constexpr Real kHiMargin = Shape::W == 2 ? Real(1) : (Shape::S == 3 ? Real(1.5) : Real(2));
+  static constexpr Real kShift = binned_by_nearest_node<D, Shape, Real> ? Real(0.5) : Real(0);
 
   explicit WindowBuilder(const GridView<D, Real>& G) {
     for (int d = 0; d < D; ++d) {
       inv_h[d] = Real(1) / G.h[std::size_t(d)];
-      origin[d] = G.origin[std::size_t(d)];
+      origin[d] = key_origin<D, Shape>(G.origin[std::size_t(d)], G.h[std::size_t(d)]);
       n[d] = G.nodes_per_dim[std::size_t(d)];
+      top[d] = n[d] - Win::extent(d);
     }
     // Each part built in a local and stored whole: lane-by-lane stores into
     // the members drew a false -Wmaybe-uninitialized from GCC 12 in some
@@ -214,7 +238,7 @@ class WindowBuilder {
       for (int j = 0; j < PL; ++j) {
         const int k = h * PL + j, d = k / W;  // lane k: direction d, node k % W
         scale[j] = d < D ? inv_h[d] : Real(1);
-        offset[j] = Real(-(k % W));
+        offset[j] = Real(-(k % W)) - kShift;  // lane j's node, in the key frame
         direction[j] = Real(d);
       }
       inv_h_lanes[h] = scale;
@@ -275,10 +299,10 @@ class WindowBuilder {
         const Real xi = (x[d][i] - origin[d]) * inv_h[d];
         // build()'s test; outside, xi is replaced by 0 before the int
         // conversion (never used: ok is false).
-        const int in = int(xi >= kLoXi) & int(xi < Real(n[d]) - kHiMargin);
+        const int in = int(xi >= kLoXi + kShift) & int(xi < Real(n[d]) - kHiMargin + kShift);
         in_all &= in;
         const Real xc = masked(xi, in);
-        const int wb = std::clamp(int(xc) - Shape::window_lo, 0, n[d] - W);
+        const int wb = std::clamp(int(xc) - Shape::window_lo, 0, top[d]);
         r[d][i] = xc - Real(wb);
         b += std::uint64_t(wb) * stride;
         stride *= std::uint64_t(n[d]);
@@ -311,9 +335,9 @@ class WindowBuilder {
     for (int d = 0; d < D; ++d) {
       const Real xi = (P.x[d][p] - origin[d]) * inv_h[d];
       // Compared in Real before any int conversion (a wild position must not overflow).
-      if (!(xi >= kLoXi && xi < Real(n[d]) - kHiMargin)) return false;
-      // Window base: cell - window_lo, moved inward at the grid's edges.
-      const int wb = std::clamp(int(xi) - Shape::window_lo, 0, n[d] - W);
+      if (!(xi >= kLoXi + kShift && xi < Real(n[d]) - kHiMargin + kShift)) return false;
+      // Window base: key cell - window_lo, moved inward at the grid's edges.
+      const int wb = std::clamp(int(xi) - Shape::window_lo, 0, top[d]);
       r[d] = xi - Real(wb);
       l[d] = Shape::S == 3 && P.lp[d] ? P.lp[d][p] : Real(0.25);
       base += std::size_t(wb) * stride;
@@ -366,8 +390,8 @@ class WindowBuilder {
     for (int d = DP - 2; d >= 0; --d) out = direction_lanes[h] == Real(d) ? Part{} + v[d] : out;
     return out;
   }
-  Real inv_h[D]{}, origin[D]{};
-  int n[D]{};
+  Real inv_h[D]{}, origin[D]{};  // origin: the key origin (kernels/binning.hpp)
+  int n[D]{}, top[D]{};          // top: the highest window base
   Part inv_h_lanes[kParts]{}, offsets_lanes[kParts]{}, direction_lanes[kParts]{};
 };
 

@@ -173,22 +173,34 @@ struct WindowBlock {
   }
 };
 
-// Vector accumulators one window block may keep in registers: AVX-512 has
-// 32, and the weights and factors of the particle need a few.
+// Vector registers one window block may keep its sums in: AVX-512 has 32,
+// AVX2 16, and the weights and factors of the particle need a few.
 #ifdef __AVX512F__
-inline constexpr int kBlockRegisterBudget = 28;
+inline constexpr int kVectorRegisters = 28;
+inline constexpr int kVectorBytes = 64;
 #else
-inline constexpr int kBlockRegisterBudget = 6;  // a unit is two AVX2 registers
+inline constexpr int kVectorRegisters = 12;
+inline constexpr int kVectorBytes = 32;
 #endif
+// The same budget in window units (a unit of 64 bytes is two AVX2
+// registers; one of 32 bytes, a row of 4 doubles, is one register either way).
+template <int D, class Shape, class Real>
+constexpr int block_register_budget() {
+  constexpr int bytes = int(sizeof(typename Window<D, Shape, Real>::V));
+  return kVectorRegisters / (bytes > kVectorBytes ? bytes / kVectorBytes : 1);
+}
 
 // Units per block group: all of the window's units when their sums fit in
-// the registers, else the largest power of two that does (3D uGIMP and
-// B-splines in double: 64 nodes x 7 quantities = 56 vectors).
+// the registers, else the largest divisor of the units that does (3D uGIMP
+// and B-splines in double: 64 nodes x 7 quantities = 56 vectors of 8 lanes,
+// 2 groups; binned by the nearest node, kernels/shape.hpp: 9 units x 7 =
+// 63 vectors of 4 lanes, 3 groups).
 template <int D, class Shape, class Real, unsigned What, bool Traction>
 constexpr int block_group_units() {
   constexpr int q = WindowBlock<D, Shape, Real, What, Traction, 1>::kQuantities;
-  int g = Window<D, Shape, Real>::units;
-  while (g > 1 && g * q > kBlockRegisterBudget) g /= 2;
+  constexpr int units = Window<D, Shape, Real>::units;
+  int g = units;
+  while (g > 1 && (g * q > block_register_budget<D, Shape, Real>() || units % g != 0)) --g;
   return g;
 }
 

@@ -200,13 +200,16 @@ Particles<D, Real> random_particles(const GridView<D, Real>& G, const std::array
   return p;
 }
 
-// The solver's binning: keys from the cell of every particle, stable counting sort.
-template <int D, class Real>
+// The solver's binning: keys from the cell (or the nearest node:
+// kernels/shape.hpp binned_by_nearest_node) of every particle, stable
+// counting sort.
+template <class Shape, int D, class Real>
 std::vector<std::uint32_t> sort_by_tile(Particles<D, Real>& p, const GridView<D, Real>& G,
                                         const TileLayout<D>& tiles) {
+  const auto origin = key_origins<D, Shape>(G.origin, G.h);
   for (std::size_t i = 0; i < p.n; ++i) {
     std::array<int, 3> c{0, 0, 0};
-    for (int d = 0; d < D; ++d) c[d] = cell_of(p.x[d][i], G.origin[d], Real(1) / G.h[d]);
+    for (int d = 0; d < D; ++d) c[d] = cell_of(p.x[d][i], origin[d], Real(1) / G.h[d]);
     p.key[i] = tiles.key(c);
   }
   std::vector<std::uint32_t> offsets, perm;
@@ -340,7 +343,10 @@ TYPED_TEST(P2G, ConstantStressForcesSumToZero) {
                      false>(103, true);
 }
 
-// Two tiles of one color never share a node under the shape function's stencil.
+// Two tiles of one color never share a node under the shape function's
+// stencil, nor under the windows the solver's kernels read and write
+// (kernels/window.hpp: every row of W nodes, zero weights included, at the
+// base the key's frame gives; binned by the nearest node in 3D double).
 TYPED_TEST(P2G, SameColorTilesTouchDisjointNodes) {
   constexpr int D = TypeParam::D;
   using Shape = typename TypeParam::Shape;
@@ -354,7 +360,7 @@ TYPED_TEST(P2G, SameColorTilesTouchDisjointNodes) {
     TileLayout<D> tiles;
     tiles.setup(T, g.cells);
     ASSERT_EQ(tiles.T, T);
-    auto sorted = p.permuted(sort_by_tile(p, g.G, tiles));
+    auto sorted = p.permuted(sort_by_tile<Shape>(p, g.G, tiles));
     const auto P = sorted.view(gimp);
     const std::array<Real, 3> inv_h{Real(1) / g.G.h[0], Real(1) / g.G.h[1], Real(1) / g.G.h[2]};
     std::vector<std::int64_t> owner(g.G.nodes);
@@ -365,8 +371,31 @@ TYPED_TEST(P2G, SameColorTilesTouchDisjointNodes) {
         if (tiles.color(tile) != color) continue;
         Stencil<D, Shape, Real> st{};
         ASSERT_TRUE(st.build(P, g.G, inv_h, i));
-        for (int k = 0; k < st.count; ++k) {
-          const std::size_t node = st.base + st.node[k];
+        std::vector<std::size_t> nodes;
+        for (int k = 0; k < st.count; ++k) nodes.push_back(st.base + st.node[k]);
+        using Win = Window<D, Shape, Real>;
+        if (Win::fits(g.G)) {
+          Win w;
+          const WindowBuilder<D, Shape, Real> builder(g.G);
+          ASSERT_TRUE(builder.build(P, i, w));
+          for (const std::size_t row : Win::offsets(g.G))
+            for (int x = 0; x < Win::W; ++x) nodes.push_back(w.base + row + std::size_t(x));
+          // Tighter: inside the node box of its key's tile (what the
+          // multimaterial fields zero, kernels/tile_reach.hpp), unless moved
+          // inward at the grid's edge (it adds zeros there). A key in
+          // another frame than the window's puts a window one node out.
+          const NodeBox box = tile_node_box(tiles, tile, g.G.nodes_per_dim, NodeReach::of<Shape>());
+          std::size_t rest = w.base;
+          for (int d = 0; d < D; ++d) {
+            const int n = g.G.nodes_per_dim[std::size_t(d)];
+            const int lo = int(rest % std::size_t(n)), hi = lo + Win::extent(d) - 1;
+            rest /= std::size_t(n);
+            if (lo == 0 || hi == n - 1) continue;
+            ASSERT_GE(lo, box.lo[std::size_t(d)]) << "particle " << i << ", direction " << d;
+            ASSERT_LE(hi, box.hi[std::size_t(d)]) << "particle " << i << ", direction " << d;
+          }
+        }
+        for (const std::size_t node : nodes) {
           if (owner[node] >= 0) {
             ASSERT_EQ(owner[node], std::int64_t(tile))
                 << "T=" << T << ": tiles " << owner[node] << " and " << tile << " (color " << color
@@ -400,7 +429,7 @@ void check_colored(int T, unsigned seed) {
   TileLayout<D> tiles;
   tiles.setup(T, natural.cells);
   ASSERT_EQ(tiles.T, T) << "tile edges are powers of two";
-  auto sorted = p.permuted(sort_by_tile(p, natural.G, tiles));
+  auto sorted = p.permuted(sort_by_tile<Shape>(p, natural.G, tiles));
   for (std::size_t i = 1; i < n; ++i)
     ASSERT_LE(sorted.key[i - 1], sorted.key[i]) << "sorted by key";
   const auto P = sorted.view(gimp);
@@ -485,7 +514,7 @@ void check_multimaterial_fields(bool banded, double band_shift, unsigned seed) {
   opt.inv_thickness = 0.5;
   TileLayout<D> tiles;
   tiles.setup(4, full.cells);
-  auto sorted = p.permuted(sort_by_tile(p, full.G, tiles));
+  auto sorted = p.permuted(sort_by_tile<Shape>(p, full.G, tiles));
   const auto P = sorted.view(gimp);
   TileSchedule r;
   r.build(tiles, sorted.key.data(), n);
@@ -577,7 +606,7 @@ void check_mixed_tile_search(bool split, double shift, unsigned seed) {
   }
   TileLayout<D> tiles;
   tiles.setup(4, g.cells);
-  auto sorted = p.permuted(sort_by_tile(p, g.G, tiles));
+  auto sorted = p.permuted(sort_by_tile<LinearShape>(p, g.G, tiles));
   TileSchedule r;
   r.build(tiles, sorted.key.data(), n);
   colored_p2g<D, Shape, Real, kMassMomentum, true, false>(sorted.view(gimp), g.G, P2GOptions{}, r,
@@ -667,7 +696,7 @@ void check_window_p2g(bool edges, bool sorted, unsigned seed) {
   if (sorted) {
     TileLayout<D> tiles;
     tiles.setup(4, win.cells);
-    p = p.permuted(sort_by_tile(p, win.G, tiles));
+    p = p.permuted(sort_by_tile<Shape>(p, win.G, tiles));
   }
   const auto P = p.view(gimp);
   P2GOptions opt;
@@ -749,7 +778,7 @@ TYPED_TEST(P2G, GroupedScatterGivesTheOneBlockSumsBitwise) {
   TileLayout<D> tiles;
   tiles.setup(4, g.cells);
   auto random = random_particles<D, Real>(g.G, g.cells, D == 2 ? 6000 : 4000, 901);
-  auto sorted = random.permuted(sort_by_tile(random, g.G, tiles));
+  auto sorted = random.permuted(sort_by_tile<Shape>(random, g.G, tiles));
   // 100 particles of field 1 in one cell: one run of 100.
   auto crowded = random_particles<D, Real>(g.G, g.cells, 100, 902);
   for (std::size_t i = 0; i < crowded.n; ++i) {
@@ -765,8 +794,15 @@ TYPED_TEST(P2G, GroupedScatterGivesTheOneBlockSumsBitwise) {
   for (const auto* list : {&sorted, &crowded, &off_grid}) {
     const std::size_t stop_at = list == &off_grid ? bad : SIZE_MAX;
     check_grouped_all_quantities<D, Shape, Real, 1>(*list, stop_at);
-    if constexpr (U >= 2) check_grouped_all_quantities<D, Shape, Real, U / 2>(*list, stop_at);
-    if constexpr (U >= 4) check_grouped_all_quantities<D, Shape, Real, 2>(*list, stop_at);
+    // Groups of every proper divisor of U that is > 1, and of 1 (windows
+    // binned by the nearest node have 9 units; the others powers of two).
+    if constexpr (U >= 2) check_grouped_all_quantities<D, Shape, Real, 1>(*list, stop_at);
+    if constexpr (U % 2 == 0 && U >= 4)
+      check_grouped_all_quantities<D, Shape, Real, U / 2>(*list, stop_at);
+    if constexpr (U % 2 == 0 && U >= 8)
+      check_grouped_all_quantities<D, Shape, Real, 2>(*list, stop_at);
+    if constexpr (U % 3 == 0 && U >= 6)
+      check_grouped_all_quantities<D, Shape, Real, U / 3>(*list, stop_at);
   }
 }
 
@@ -809,7 +845,7 @@ struct PackedTestSets {
     TileLayout<2> tiles;
     tiles.setup(4, g.cells);
     auto random = random_particles<2, Real>(g.G, g.cells, 6000, seed);
-    sorted = random.permuted(sort_by_tile(random, g.G, tiles));
+    sorted = random.permuted(sort_by_tile<LinearShape>(random, g.G, tiles));
     crowded = random_particles<2, Real>(g.G, g.cells, 100, seed + 1);
     for (std::size_t i = 0; i < crowded.n; ++i) {
       crowded.field[i] = crowded_field;
@@ -959,7 +995,7 @@ void check_fused_musl(unsigned seed) {
   auto a = random_particles<D, Real>(fused.G, fused.cells, n, seed);
   TileLayout<D> tiles;
   tiles.setup(4, fused.cells);
-  a = a.permuted(sort_by_tile(a, fused.G, tiles));
+  a = a.permuted(sort_by_tile<Shape>(a, fused.G, tiles));
   auto b = a;
   std::array<std::vector<Real>, D> xa, xb;
   auto Pa = a.view(gimp), Pb = b.view(gimp);
@@ -1229,7 +1265,7 @@ TEST(TileSchedule, SharesPartitionEachColorByParticleQuantiles) {
     p.x[0][i] = g.G.origin[0] + 0.25 * (p.x[0][i] - g.G.origin[0]);
   TileLayout<2> tiles;
   tiles.setup(4, g.cells);
-  auto sorted = p.permuted(sort_by_tile(p, g.G, tiles));
+  auto sorted = p.permuted(sort_by_tile<LinearShape>(p, g.G, tiles));
   TileSchedule r;
   r.build(tiles, sorted.key.data(), sorted.n);
   ASSERT_EQ(r.begin.back(), sorted.n);

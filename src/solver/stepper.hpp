@@ -90,7 +90,9 @@ class Stepper final : public Simulation {
   // layout and the grid geometry (a call per particle cost ~12 % of a 2D
   // linear step).
   using KeyFn = PositionTile<D, Real>;
-  KeyFn key_fn() const { return KeyFn::of(tiles_, G_.origin, G_.h, P_.x); }
+  KeyFn key_fn() const {
+    return KeyFn::of(tiles_, key_origins<D, Shape>(G_.origin, G_.h), G_.h, P_.x);
+  }
 
   void setup_particles(const ParticleSeeds& seeds);
   void setup_grid();

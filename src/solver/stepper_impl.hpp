@@ -216,7 +216,8 @@ void Stepper<D, Shape, Real>::build_stress_table() {
 template <int D, class Shape, class Real>
 std::uint32_t Stepper<D, Shape, Real>::key_of_position(std::size_t p) const {
   std::array<int, 3> c{0, 0, 0};
-  for (int d = 0; d < D; ++d) c[d] = cell_of(P_.x[d][p], G_.origin[d], Real(1) / G_.h[d]);
+  for (int d = 0; d < D; ++d)
+    c[d] = cell_of(P_.x[d][p], key_origin<D, Shape>(G_.origin[d], G_.h[d]), Real(1) / G_.h[d]);
   return tiles_.key(c);
 }
 
