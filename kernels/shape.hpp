@@ -21,7 +21,7 @@ struct LinearShape {
   static constexpr int S = 2;
   static constexpr int W = 2;          // window nodes per direction (kernels/window.hpp)
   static constexpr int window_lo = 0;  // window starts at cell - window_lo
-  static constexpr bool nearest_node_stencil = false;  // kernels/shape.hpp key_origin
+  static constexpr bool nearest_node_stencil = false;  // binned_by_nearest_node below
   static constexpr const char* name = "linear";
   template <class Real>
   static int eval(Real xi, Real /*half_width*/, Real* w, Real* dw) {
@@ -181,8 +181,8 @@ struct BSpline3Shape {
 // 3 rows of 16 bytes fill no register (docs/performance.md "Windows centred
 // on the nearest node").
 template <int D, class Shape, class Real>
-inline constexpr bool binned_by_nearest_node = Shape::nearest_node_stencil&& D == 3 &&
-                                               sizeof(Real) == 8;
+inline constexpr bool binned_by_nearest_node = (D == 3) &&
+                                               (sizeof(Real) == 8) && Shape::nearest_node_stencil;
 
 // The origin particles are binned from: the grid's, or half a cell below it
 // when binned by the nearest node, so that cell_of(x, key_origin, 1/h)

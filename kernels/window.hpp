@@ -217,8 +217,9 @@ class WindowBuilder {
 
   // Lowest xi the stencil allows, and the margin it needs above: linear
   // [0, n - 1), uGIMP and quadratic [1/2, n - 3/2) (stencil base
-  // floor(xi - 1/2)), cubic [1, n - 2). Centred shapes measure xi from
-  // their key origin, half a cell lower (xi + 1/2 in [1, n - 1)).
+  // floor(xi - 1/2)), cubic [1, n - 2). Shapes binned by the nearest node
+  // measure xi from their key origin, half a cell lower (xi + 1/2 in
+  // [1, n - 1)).
   static constexpr Real kLoXi = Shape::W == 2 ? Real(0) : (Shape::S == 3 ? Real(0.5) : Real(1));
   static constexpr Real kHiMargin = Shape::W == 2 ? Real(1) : (Shape::S == 3 ? Real(1.5) : Real(2));
   static constexpr Real kShift = binned_by_nearest_node<D, Shape, Real> ? Real(0.5) : Real(0);
