@@ -41,10 +41,16 @@ namespace detail {
 // "Loops the compiler vectorises"). With Damping, node n's p.p/m goes to
 // pv[n - b] (0 for slivers), and the caller sums them in node order, the
 // order of the scalar loop, so the damping loss keeps its bits.
+// noinline: inlined into grid_update's lambda (in bench_grid.cpp's
+// translation unit), GCC 12 compiled the loop as scalar code, 4.7 ns/node
+// against 1.2 in 3D (docs/performance.md "The grid stage on two threads");
+// out of line it vectorises in every unit, and tools/check_vectorised.py
+// sees every copy.
 template <int D, class Real, bool Interface, bool Damping, bool Velocities>
-void update_deformable(const GridView<D, Real>& G, const GridVelocity<D, Real>& V, std::size_t o,
-                       std::size_t b, std::size_t e, Real dt, Real alpha, Real thr,
-                       const Real (&gacc)[D], double* __restrict pv) {
+[[gnu::noinline]] void update_deformable(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
+                                         std::size_t o, std::size_t b, std::size_t e, Real dt,
+                                         Real alpha, Real thr, const Real (&gacc)[D],
+                                         double* __restrict pv) {
   const Real* __restrict m_ = G.m + o;
   Real* __restrict p_[D];
   const Real* __restrict f_[D];
@@ -157,6 +163,21 @@ double grid_update(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
     body(f, b, e, acc);
     after(f, b, e);
   };
+  if (q.damping == 0) {
+    // No loss to sum: each thread updates exactly the nodes it owns. The
+    // fixed 4096-node chunks of the sum below would hand a thread the
+    // nodes up to its last chunk's end, which the other thread owns (and
+    // whose lines sit in the other core's cache): in the 3D block of 22 707
+    // nodes split at 11 353, thread 0 took 12 288 and ran ~1.5x longer than
+    // thread 1 (docs/performance.md "The grid stage on two threads"). A
+    // node's result does not depend on the range it is in.
+#pragma omp parallel if (G.nodes * std::size_t(G.fields) >= kParallelMin)
+    for_own_field_nodes(own, G.nodes, G.fields, [&](int f, std::size_t b, std::size_t e) {
+      std::array<double, 1> none{};
+      update_then_hook(f, b, e, none);
+    });
+    return 0;
+  }
   double loss = 0;
   for (const auto& field_loss : owned_field_sums<1>(own, G.nodes, G.fields, update_then_hook))
     loss += field_loss[0];

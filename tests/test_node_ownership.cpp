@@ -168,37 +168,48 @@ void expect_same_momenta_and_velocities(const UpdateGrid& ref, const UpdateGrid&
 }
 
 TEST(NodeOwnership, GridUpdateAndVelocitiesBitwiseWhateverTheSplit) {
-  // 300 x 170 nodes (13 reduction chunks per field), damping on so the
-  // loss is a real sum; 1 thread vs 2 threads with several cuts.
+  // 300 x 170 nodes (13 reduction chunks per field); 1 thread vs 2 threads
+  // with several cuts. Damping on: the loss is a real sum, computed in the
+  // reduction's fixed chunks. Damping off: each thread updates exactly its
+  // own nodes (no chunks), with the velocities in a separate pass or in the
+  // update's own (GridUpdateParams::velocities).
   const std::array<int, 3> dims{300, 170, 1};
-  mmpm::GridUpdateParams q;
-  q.dt = 1e-3;
-  q.damping = 0.7;
-  q.mass_threshold = 1e-12;
-  q.body_accel[1] = -9.81;
-  q.has_interface_force = true;
-  auto run = [&](int threads, std::vector<std::size_t> split, UpdateGrid& g) {
-    const int saved = omp_get_max_threads();
-    omp_set_num_threads(threads);
-    NodeOwnership own;
-    own.split = std::move(split);
-    const double loss = mmpm::grid_update(g.G, g.V, q, own);
-    mmpm::grid_velocities(g.G, g.V, 1e-12, own);
-    omp_set_num_threads(saved);
-    return loss;
-  };
-  UpdateGrid ref(dims);
-  const double loss_ref = run(1, {}, ref);
-  EXPECT_GT(loss_ref, 0.0);
-  const std::size_t n = ref.nodes;
-  for (const auto& split : std::vector<std::vector<std::size_t>>{
-           {}, {0, 1, n}, {0, 4096 * 5 + 17, n}, {0, n, n}, {0, 0, n}}) {
-    UpdateGrid g(dims);
-    const double loss = run(2, split, g);
-    const std::string where = "split at " + std::to_string(split.empty() ? 0 : split[1]);
-    EXPECT_EQ(loss, loss_ref) << where;
-    expect_same_momenta_and_velocities(ref, g, where);
-  }
+  for (const double damping : {0.7, 0.0})
+    for (const bool fused : {false, true}) {
+      mmpm::GridUpdateParams q;
+      q.dt = 1e-3;
+      q.damping = damping;
+      q.mass_threshold = 1e-12;
+      q.body_accel[1] = -9.81;
+      q.has_interface_force = true;
+      q.velocities = fused;
+      auto run = [&](int threads, std::vector<std::size_t> split, UpdateGrid& g) {
+        const int saved = omp_get_max_threads();
+        omp_set_num_threads(threads);
+        NodeOwnership own;
+        own.split = std::move(split);
+        const double loss = mmpm::grid_update(g.G, g.V, q, own);
+        if (!fused) mmpm::grid_velocities(g.G, g.V, 1e-12, own);
+        omp_set_num_threads(saved);
+        return loss;
+      };
+      UpdateGrid ref(dims);
+      const double loss_ref = run(1, {}, ref);
+      if (damping > 0) {
+        EXPECT_GT(loss_ref, 0.0);
+      }
+      const std::size_t n = ref.nodes;
+      for (const auto& split : std::vector<std::vector<std::size_t>>{
+               {}, {0, 1, n}, {0, 4096 * 5 + 17, n}, {0, n, n}, {0, 0, n}, {0, 3, n}}) {
+        UpdateGrid g(dims);
+        const double loss = run(2, split, g);
+        const std::string where = "damping " + std::to_string(damping) +
+                                  (fused ? ", fused velocities" : "") + ", split at " +
+                                  std::to_string(split.empty() ? 0 : split[1]);
+        EXPECT_EQ(loss, loss_ref) << where;
+        expect_same_momenta_and_velocities(ref, g, where);
+      }
+    }
 }
 
 TEST(NodeOwnership, MomentumVelocitiesBitwiseWhateverTheSplit) {
