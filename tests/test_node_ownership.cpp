@@ -75,13 +75,15 @@ TEST(NodeOwnership, CutsNearestTheEvenSplitInsideTheThreadsBands3D) {
     SCOPED_TRACE(color_major ? "color-major" : "tile order");
     // 16^3 cells (17^3 = 4913 nodes), tiles of 4: thread 1's tiles begin in
     // tile layers z = 2 and 3 (bands: node layers 8 .. 16), which hold the
-    // even cut.
+    // even cut 2456, rounded to the nearest multiple of 16 nodes (a
+    // cache line of floats): 2464.
     mmpm::TileLayout<3> layout;
     layout.setup(4, {16, 16, 16}, color_major);
     const std::array<int, 3> nodes{17, 17, 17};
     const auto all = block_schedule<3>(layout, {0, 0, 0}, {16, 16, 16});
     const NodeOwnership two = mmpm::node_ownership<3>(layout, nodes, all, 2);
-    EXPECT_EQ(two.split, (std::vector<std::size_t>{0, 4913 / 2, 17 * 17 * 17}));
+    EXPECT_EQ(two.split, (std::vector<std::size_t>{0, 2464, 17 * 17 * 17}));
+    EXPECT_EQ(two.split[1] % mmpm::kNodeCutAlign, 0u);
   }
 }
 
@@ -92,14 +94,15 @@ TEST(NodeOwnership, ThickTileLayersNoLongerLeaveOneThreadAThirdOfTheNodes) {
     // 22 707 nodes), tiles of 8, particles in cells 2..25 x 2..25 x 2..23.
     // Thread 1's tiles begin in tile layers z = 1 or 2 (node layers 8 ..
     // 24). A cut at the first node of layer 8 gave thread 0 ~30 % of the
-    // nodes. The cut is the even one, inside those bands.
+    // nodes. The cut is the even one (11 353) on the nearest multiple of
+    // 16 nodes, inside those bands.
     mmpm::TileLayout<3> layout;
     layout.setup(8, {28, 28, 26}, color_major);
     const std::array<int, 3> nodes{29, 29, 27};
     const auto block = block_schedule<3>(layout, {2, 2, 2}, {26, 26, 24});
     const NodeOwnership two = mmpm::node_ownership<3>(layout, nodes, block, 2);
     const std::size_t total = 29 * 29 * 27, layer = 29 * 29;
-    EXPECT_EQ(two.split, (std::vector<std::size_t>{0, total / 2, total}));
+    EXPECT_EQ(two.split, (std::vector<std::size_t>{0, 11360, total}));
     EXPECT_GE(two.split[1], 8 * layer);
     EXPECT_LE(two.split[1], 24 * layer);
   }
