@@ -3,6 +3,7 @@
 // Every particle reads only its own material field.
 #pragma once
 
+#include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -230,16 +231,21 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
     if constexpr (kScatter) scatter_momentum(w, p, fo);
     return true;
   };
+  // The deferred scatter's sources, filled in place batch by batch (zeroed
+  // once here, not once per batch).
+  struct NoSources {};
+  std::conditional_t<kDefer, std::array<ScatterSource<D, Real>, kWeightBatch>, NoSources> sources{};
   auto after_batch = [&](std::size_t first, std::size_t n, const Weights* w, const bool* ok) {
     if constexpr (kDefer) {
       std::size_t base[kWeightBatch];
-      ScatterSource<D, Real> s[kWeightBatch];
       std::size_t count = 0;
       for (; count < n && ok[count]; ++count) {
         const std::size_t p = first + count;
         base[count] = w[count].base + field_offset<MultiField>(P, G, p);
-        s[count] = momentum_source(p);
+        fill_scatter_source<D, Real, kMomentumOnly, false>(sources[count], P, P2GOptions{}, Real(1),
+                                                          p);
       }
+      const ScatterSource<D, Real>* s = sources.data();
       deferred.add(w, base, s, count, count == n && first + n < end);
     }
   };

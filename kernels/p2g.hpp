@@ -106,7 +106,7 @@ std::size_t p2g_range_grouped(const ParticleView<D, Real>& particles, const Grid
     while (ok < n && inside[ok]) ++ok;
     for (std::size_t i = 0; i < ok; ++i) {
       base[i] = w[i].base + field_offset<MultiField>(P, G, first + i);
-      q[i] = scatter_source<D, Real, What, Traction>(P, opt, inv_t, first + i);
+      fill_scatter_source<D, Real, What, Traction>(q[i], P, opt, inv_t, first + i);
     }
     scatter.add(w, base, q, ok, ok == n && first + n < end);
     if (ok < n) return first + ok;  // nothing carried: `more` was false

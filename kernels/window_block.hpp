@@ -40,26 +40,43 @@ struct ScatterSource {
 };
 
 // The per-particle factors of particle p (what WindowBlock::accumulate
-// scatters), for P2G and MUSL's momentum scatter in G2P. With What =
-// kMomentumOnly only m and mv are set (opt and inv_t are not read).
+// scatters), for P2G and MUSL's momentum scatter in G2P, written into q in
+// place. With What = kMomentumOnly only m and mv are set (opt and inv_t are
+// not read); the other fields keep what they held. Why in place: the batch
+// loops that fill an array of sources (p2g_range_grouped, G2P's deferred
+// momentum scatter) built each one in a stack temporary and copied it with
+// 64-byte loads of a struct just written by 16-byte stores; every copy
+// waited on a failed store-to-load forward (~27 % of the 3D uGIMP batch
+// loop's samples, docs/performance.md "Scatter sources filled in place").
 template <int D, class Real, unsigned What, bool Traction>
-[[gnu::always_inline]] inline ScatterSource<D, Real> scatter_source(const ParticleView<D, Real>& P,
-                                                                    const P2GOptions& opt,
-                                                                    Real inv_t, std::size_t p) {
+[[gnu::always_inline]] inline void fill_scatter_source(ScatterSource<D, Real>& q,
+                                                       const ParticleView<D, Real>& P,
+                                                       const P2GOptions& opt, Real inv_t,
+                                                       std::size_t p) {
   constexpr int NS = kStressComponents<D>;
-  ScatterSource<D, Real> q;
-  q.m = P.m[p];
-  for (int d = 0; d < D; ++d) q.mv[d] = q.m * P.v[d][p];
+  const Real m = P.m[p];
+  q.m = m;
+  for (int d = 0; d < D; ++d) q.mv[d] = m * P.v[d][p];
   if constexpr ((What & kForce) != 0) {
-    for (int c = 0; c < NS; ++c) q.vs[c] = P.V[p] * P.s[c][p];
+    const Real V = P.V[p];
+    for (int c = 0; c < NS; ++c) q.vs[c] = V * P.s[c][p];
     if constexpr (Traction)
       for (int d = 0; d < D; ++d) q.fe[d] = P.fext[d][p];
   }
   if constexpr ((What & kMultimaterial) != 0) {
     q.area = P.V[p] * (D == 2 ? inv_t : Real(1));
     for (int d = 0; d < D; ++d)
-      q.mw[d] = q.m * separation_coordinate(P, opt.position_separation, d, p);
+      q.mw[d] = m * separation_coordinate(P, opt.position_separation, d, p);
   }
+}
+
+// The same factors as a value (the one-block scatters keep it in registers).
+template <int D, class Real, unsigned What, bool Traction>
+[[gnu::always_inline]] inline ScatterSource<D, Real> scatter_source(const ParticleView<D, Real>& P,
+                                                                    const P2GOptions& opt,
+                                                                    Real inv_t, std::size_t p) {
+  ScatterSource<D, Real> q;
+  fill_scatter_source<D, Real, What, Traction>(q, P, opt, inv_t, p);
   return q;
 }
 
