@@ -61,9 +61,12 @@ inline G2PParams g2p_bench_params() {
   return q;
 }
 
-// Windowed = false: the pointwise reference gather (kernels/g2p.hpp), the
-// baseline the solver's windowed gather is compared with in the same run.
-template <int D, class Shape, class Real, bool Windowed>
+// The gathers compared in one run: the solver's (g2p_range), the windowed
+// one without pairs of particles per vector (G2PGather::kPairs), and the
+// pointwise reference (kernels/g2p.hpp).
+enum class Gather { solver, one_per_vector, pointwise };
+
+template <int D, class Shape, class Real, Gather Kernel>
 void bm_g2p(benchmark::State& state, int threads) {
   use_threads(threads);
   auto& fx = g2p_fixture<D, Shape, Real>();
@@ -81,10 +84,14 @@ void bm_g2p(benchmark::State& state, int threads) {
 #pragma omp parallel for schedule(static) if (n >= kParallelMin)
     for (std::size_t c = 0; c < chunks; ++c) {
       const std::size_t b = c * kReduceChunk, e = std::min(n, b + kReduceChunk);
-      res[c] = Windowed
-                   ? g2p_range<D, Shape, Real, What, false, false, false>(P, G, V, q, key_of, b, e)
-                   : g2p_range_pointwise<D, Shape, Real, What, false, false, false>(P, G, V, q,
-                                                                                    key_of, b, e);
+      if constexpr (Kernel == Gather::solver)
+        res[c] = g2p_range<D, Shape, Real, What, false, false, false>(P, G, V, q, key_of, b, e);
+      else if constexpr (Kernel == Gather::one_per_vector)
+        res[c] = g2p_range_impl<D, Shape, Real, What, false, false, false, true, false>(
+            P, G, V, q, key_of, b, e);
+      else
+        res[c] = g2p_range_pointwise<D, Shape, Real, What, false, false, false>(P, G, V, q, key_of,
+                                                                                b, e);
     }
     keep(res.data());
     benchmark::ClobberMemory();
@@ -106,8 +113,9 @@ void bm_g2p(benchmark::State& state, int threads) {
 // MUSL's fused pass (G2P of the updated velocity + P2G of m v into the
 // zeroed grid momentum, kUpdateMotion | kScatterMomentum), colored tile by
 // tile as the Stepper runs it. Solver = true: g2p_range, the solver's
-// choice (packed in 2D linear, kernels/g2p_packed.hpp); false: the
-// one-particle windowed kernel, the baseline in the same run.
+// choice (packed in 2D linear, kernels/g2p_packed.hpp; pairs of particles
+// per vector in 3D double); false: the one-particle windowed kernel, the
+// baseline in the same run.
 template <int D, class Shape, class Real, bool Solver>
 void bm_g2p_fused(benchmark::State& state, int threads) {
   use_threads(threads);
@@ -121,14 +129,14 @@ void bm_g2p_fused(benchmark::State& state, int threads) {
   std::size_t bad = SIZE_MAX;
   for (auto _ : state) {
     for (int d = 0; d < D; ++d) std::fill(G.p[d], G.p[d] + G.nodes, Real(0));
-    bad =
-        std::min(bad, colored_tiles(fx.bins.schedule, P.n, [&](std::size_t b, std::size_t e) {
-                   return (Solver ? g2p_range<D, Shape, Real, What, false, false, false>(
-                                        P, G, V, q, key_of, b, e)
-                                  : g2p_range_impl<D, Shape, Real, What, false, false, false, true>(
-                                        P, G, V, q, key_of, b, e))
-                       .bad;
-                 }));
+    bad = std::min(
+        bad, colored_tiles(fx.bins.schedule, P.n, [&](std::size_t b, std::size_t e) {
+          return (Solver ? g2p_range<D, Shape, Real, What, false, false, false>(P, G, V, q, key_of,
+                                                                                b, e)
+                         : g2p_range_impl<D, Shape, Real, What, false, false, false, true, false>(
+                               P, G, V, q, key_of, b, e))
+              .bad;
+        }));
     keep(G.p[0]);
     benchmark::ClobberMemory();
   }
@@ -185,23 +193,26 @@ void bm_constitutive(benchmark::State& state, int threads) {
   state.counters["threads"] = threads;
 }
 
+template <int D, class Shape, class Real, Gather Kernel>
+void register_g2p_kernel(const char* family) {
+  for (int threads : {1, 2}) {
+    const std::string name = std::string(family) + "/dim:" + std::to_string(D) +
+                             "/shape:" + Shape::name + "/real:" + real_name<Real>() +
+                             "/threads:" + std::to_string(threads);
+    auto* b = benchmark::RegisterBenchmark(name.c_str(), [threads](benchmark::State& st) {
+      bm_g2p<D, Shape, Real, Kernel>(st, threads);
+    });
+    configure(b->UseRealTime()->Unit(benchmark::kMillisecond), 0.1);
+  }
+}
+
 template <int D, class Shape, class Real>
 void register_g2p_case() {
-  for (const char* kernel : {"window", "pointwise"})
-    for (int threads : {1, 2}) {
-      const bool windowed = kernel[0] == 'w';
-      const std::string name = std::string(windowed ? "g2p" : "g2p_pointwise") +
-                               "/dim:" + std::to_string(D) + "/shape:" + Shape::name +
-                               "/real:" + real_name<Real>() + "/threads:" + std::to_string(threads);
-      auto* b =
-          benchmark::RegisterBenchmark(name.c_str(), [threads, windowed](benchmark::State& st) {
-            if (windowed)
-              bm_g2p<D, Shape, Real, true>(st, threads);
-            else
-              bm_g2p<D, Shape, Real, false>(st, threads);
-          });
-      configure(b->UseRealTime()->Unit(benchmark::kMillisecond), 0.1);
-    }
+  register_g2p_kernel<D, Shape, Real, Gather::solver>("g2p");
+  // Only where the solver pairs particles, so the two differ.
+  if constexpr (G2PGather<D, Shape, Real, true>::kPairs)
+    register_g2p_kernel<D, Shape, Real, Gather::one_per_vector>("g2p_one_per_vector");
+  register_g2p_kernel<D, Shape, Real, Gather::pointwise>("g2p_pointwise");
 }
 
 template <int D, class Shape, class Real>
@@ -243,6 +254,8 @@ void register_dim_real() {
 void register_g2p() {
   register_g2p_fused_case<2, LinearShape, double>();
   register_g2p_fused_case<2, LinearShape, float>();
+  register_g2p_fused_case<3, GimpShape, double>();
+  register_g2p_fused_case<3, BSpline2Shape, double>();
   register_dim_real<2, double>();
   register_dim_real<2, float>();
   register_dim_real<3, double>();

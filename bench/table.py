@@ -259,6 +259,8 @@ def kernel_section(R):
            "pointwise = the node-by-node reference gather. MUSL fused G2P+P2G: MUSL's first "
            "particle pass (G2P of the new velocity, then P2G of m v with the same window), colored "
            "as in the step; its reference column is the one-particle windowed kernel. "
+              "G2P one particle per vector: the 3D double windowed gather without pairs of "
+              "particles per 512-bit vector, the solver's baseline in the same run. "
            "Constitutive: isotropic small-strain "
            "update (plane strain in 2D). Same particle blocks as P2G.", ""]
     header = ["kernel", "dim", "shape", "real", "1 thread", "2 threads", "speed-up",
@@ -275,6 +277,13 @@ def kernel_section(R):
                     continue
                 rows.append(["G2P", dim + "D", shape, real, fmt(v1), fmt(v2), ratio(v1, v2), fmt(gb),
                              fmt(p1), ratio(p1, v1)])
+                # Where the solver gathers two particles per vector (3D
+                # double): the windowed gather one particle at a time, this run.
+                u1 = R.value("g2p_one_per_vector", ns, dim=dim, shape=shape, real=real, threads=1)
+                u2 = R.value("g2p_one_per_vector", ns, dim=dim, shape=shape, real=real, threads=2)
+                if u1 is not None or u2 is not None:
+                    rows.append(["G2P one particle per vector", dim + "D", shape, real, fmt(u1), fmt(u2),
+                                 ratio(u1, u2), "–", "–", ratio(u1, v1) + " (vs pairs)"])
             # MUSL's fused pass (G2P + P2G of m v): the solver's kernel vs the
             # one-particle windowed kernel, both in this run.
             for shape in SHAPES:

@@ -25,7 +25,8 @@ namespace mmpm {
 // where A = sum over the rows of (wy wz) v_row, B = sum of (gy wz) v_row,
 // C = sum of (wy gz) v_row: three vector multiply-adds per row and field
 // instead of one scalar pass per node. Pointwise: node by node on the stencil.
-template <int D, class Shape, class Real, bool Windowed>
+// Pairs = false: never two particles per vector (the benchmark baseline).
+template <int D, class Shape, class Real, bool Windowed, bool Pairs = true>
 struct G2PGather {
   using Win = Window<D, Shape, Real>;
   using St = Stencil<D, Shape, Real>;
@@ -63,12 +64,53 @@ struct G2PGather {
   // shuffle) were repeated for every particle of the cell. Same values,
   // same sums: bitwise the per-particle loads (docs/performance.md "Unit
   // loops kept inline; a window's grid values held for its run").
+  //
+  // Two particles at a time (kPairs: 3D double windows of one row of 4
+  // nodes per unit, AVX-512): the window's rows are held twice over, one
+  // copy per 256-bit half, so a pair of particles of one window runs every
+  // product and sum in one 512-bit vector (gather_pair). The one-particle
+  // gather reads the lower half.
+  static constexpr bool kPairs =
+      Pairs && Windowed && D == 3 && Win::L == 4 && sizeof(Real) == 8 && kVectorBytes == 64;
+  using V2 = Lanes<Real, 8>;
+  using HeldVec = std::conditional_t<kPairs, V2, typename Win::V>;
   struct WindowValues {
     std::size_t base = SIZE_MAX;
-    typename Win::V vel[D][Win::units] = {}, dvel[D][Win::units] = {};
+    HeldVec vel[D][Win::units] = {}, dvel[D][Win::units] = {};
   };
   struct NoValues {};
   using Held = std::conditional_t<Windowed, WindowValues, NoValues>;
+
+  // Unit u of one array, held as HeldVec.
+  template <int u>
+  [[gnu::always_inline]] HeldVec held_load(const Real* a) const {
+    const auto v = Win::template load<u>(a, offsets);
+    if constexpr (kPairs)
+      return __builtin_shufflevector(v, v, 0, 1, 2, 3, 0, 1, 2, 3);
+    else
+      return v;
+  }
+  // The one-particle unit of a held vector.
+  [[gnu::always_inline]] static typename Win::V held_row(const HeldVec& v) {
+    if constexpr (kPairs)
+      return __builtin_shufflevector(v, v, 0, 1, 2, 3);
+    else
+      return v;
+  }
+  // Loads the window at b unless it is the one held.
+  template <bool Motion>
+  [[gnu::always_inline]] void hold(const GridVelocity<D, Real>& V, std::size_t b,
+                                   Held& held) const {
+    if (b == held.base) return;
+    held.base = b;
+    static_for<Win::units>([&](auto uc) __attribute__((always_inline)) {
+      constexpr int u = decltype(uc)::value;
+      for (int d = 0; d < D; ++d) {
+        held.vel[d][u] = held_load<u>(V.vel[d] + b);
+        if constexpr (Motion) held.dvel[d][u] = held_load<u>(V.dvel[d] + b);
+      }
+    });
+  }
 
   // vn, dv: velocity and its change over the step; L row-major dv_a/dx_b.
   template <bool Motion, bool Gradient>
@@ -95,29 +137,19 @@ struct G2PGather {
       // then v_p = sum(X A), L_d,x = sum(GX A), L_d,y = sum(X B), L_d,z = sum(X C).
       using Vec = typename Win::V;
       constexpr int Ln = Win::L;
-      const auto& off = offsets;
-      if (b != held.base) {
-        held.base = b;
-        static_for<Win::units>([&](auto uc) __attribute__((always_inline)) {
-          constexpr int u = decltype(uc)::value;
-          for (int d = 0; d < D; ++d) {
-            held.vel[d][u] = Win::template load<u>(V.vel[d] + b, off);
-            if constexpr (Motion) held.dvel[d][u] = Win::template load<u>(V.dvel[d] + b, off);
-          }
-        });
-      }
+      hold<Motion>(V, b, held);
       Vec A[D] = {}, B[D] = {}, C[D] = {}, Q[D] = {};
       static_for<Win::units>([&](auto uc) __attribute__((always_inline)) {
         constexpr int u = decltype(uc)::value;
         const Vec Yu = w.template Y<u>(), GYu = w.template GY<u>(), GZu = w.template GZ<u>();
         for (int d = 0; d < D; ++d) {
-          const Vec vu = held.vel[d][u];
+          const Vec vu = held_row(held.vel[d][u]);
           A[d] += Yu * vu;
           if constexpr (Gradient) {
             B[d] += GYu * vu;
             if constexpr (D == 3) C[d] += GZu * vu;
           }
-          if constexpr (Motion) Q[d] += Yu * held.dvel[d][u];
+          if constexpr (Motion) Q[d] += Yu * held_row(held.dvel[d][u]);
         }
       });
       const Vec X = w.X(), GX = w.GX();
@@ -147,10 +179,91 @@ struct G2PGather {
       }
     }
   }
+
+  // gather() for two particles a and b of one window (base b0, field offset
+  // included), lanes 0-3 particle a's, 4-7 particle b's. Every lane runs
+  // gather()'s operations in gather()'s order (the same products Y v,
+  // GY v, GZ v, Y dv, unit by unit, then the same tree of sums), so each
+  // particle gets gather()'s bits (tests/test_p2g.cpp
+  // G2PPairGather.SameBitsAsOneParticle): which particles pair up may
+  // depend on the thread's range without changing a result. Why: gather()
+  // runs 4-lane vectors, half an AVX-512 register; pairs take 6-9 % off
+  // the 3D G2P kernels on one thread (docs/performance.md "Two particles
+  // per vector in the 3D gathers").
+  template <bool Motion, bool Gradient>
+  [[gnu::always_inline]] void gather_pair(const Weights& wa, const Weights& wb,
+                                          const GridVelocity<D, Real>& V, std::size_t b0,
+                                          Held& held, Real (*vn)[D], Real (*dv)[D],
+                                          Real (*L)[D * D]) const requires(kPairs) {
+    constexpr int W = Win::W, WY = Win::WY;
+    hold<Motion>(V, b0, held);
+    // Lane k of the pair: lane j of a's weights for k < 4, of b's for k >= 4.
+    auto pair_lane =
+        []<class VA>(const VA& a, const VA& b, auto jc) __attribute__((always_inline)) {
+      constexpr int j = decltype(jc)::value, n = int(sizeof(VA) / sizeof(Real));
+      return V2(__builtin_shufflevector(a, b, j, j, j, j, n + j, n + j, n + j, n + j));
+    };
+    V2 wy[WY], dwy[WY], wz[WY], dwz[WY];
+    static_for<WY>([&](auto jc) __attribute__((always_inline)) {
+      constexpr int j = decltype(jc)::value;
+      wy[j] = pair_lane(wa.wa, wb.wa, std::integral_constant<int, W + j>{});
+      wz[j] = pair_lane(wa.wa, wb.wa, std::integral_constant<int, 2 * W + j>{});
+      if constexpr (Gradient) {
+        dwy[j] = pair_lane(wa.dwa, wb.dwa, std::integral_constant<int, W + j>{});
+        dwz[j] = pair_lane(wa.dwa, wb.dwa, std::integral_constant<int, 2 * W + j>{});
+      }
+    });
+    V2 A[D] = {}, B[D] = {}, C[D] = {}, Q[D] = {};
+    static_for<Win::units>([&](auto uc) __attribute__((always_inline)) {
+      constexpr int u = decltype(uc)::value, jy = u % WY, jz = u / WY;  // one row per unit
+      // Window::Y / GY / GZ: the y factor times the z factor, lane by lane.
+      const V2 Yu = wy[jy] * wz[jz];
+      for (int d = 0; d < D; ++d) {
+        const V2 vu = held.vel[d][u];
+        A[d] += Yu * vu;
+        if constexpr (Gradient) {
+          const V2 GYu = dwy[jy] * wz[jz], GZu = wy[jy] * dwz[jz];
+          B[d] += GYu * vu;
+          C[d] += GZu * vu;
+        }
+        if constexpr (Motion) Q[d] += Yu * held.dvel[d][u];
+      }
+    });
+    const V2 X = __builtin_shufflevector(wa.wa, wb.wa, 0, 1, 2, 3, 16, 17, 18, 19);
+    const V2 GX = __builtin_shufflevector(wa.dwa, wb.dwa, 0, 1, 2, 3, 16, 17, 18, 19);
+    for (int d = 0; d < D; ++d) {
+      // lanes_sum4 on each half: {sum XA, sum XQ, sum GX A, sum XB} per particle.
+      const V2 a = X * A[d], q = X * Q[d], c = GX * A[d], e = X * B[d];
+      const V2 aq = __builtin_shufflevector(a, q, 0, 8, 2, 10, 4, 12, 6, 14) +
+                    __builtin_shufflevector(a, q, 1, 9, 3, 11, 5, 13, 7, 15);
+      const V2 ce = __builtin_shufflevector(c, e, 0, 8, 2, 10, 4, 12, 6, 14) +
+                    __builtin_shufflevector(c, e, 1, 9, 3, 11, 5, 13, 7, 15);
+      const V2 s1 = __builtin_shufflevector(aq, ce, 0, 1, 8, 9, 4, 5, 12, 13) +
+                    __builtin_shufflevector(aq, ce, 2, 3, 10, 11, 6, 7, 14, 15);
+      for (int k = 0; k < 2; ++k) {
+        if constexpr (Motion) vn[k][d] = s1[4 * k], dv[k][d] = s1[4 * k + 1];
+        if constexpr (Gradient) {
+          L[k][d * D + 0] = s1[4 * k + 2];
+          L[k][d * D + 1] = s1[4 * k + 3];
+        }
+      }
+      if constexpr (Gradient) {
+        const V2 xc = X * C[d];
+        for (int k = 0; k < 2; ++k) {
+          Real sum = 0;  // lanes_sum's order
+          for (int l = 0; l < 4; ++l) sum += xc[4 * k + l];
+          L[k][d * D + 2] = sum;
+        }
+      }
+    }
+  }
 };
 
+// PairGathers = false keeps the one-particle gather where pairs would run
+// (G2PGather::kPairs), the baseline bench/bench_g2p.cpp measures them against.
 template <int D, class Shape, class Real, unsigned What, bool MultiField, bool Traction,
-          bool Gravity, bool Windowed, class KeyFn, class StressFn = NoStressUpdate>
+          bool Gravity, bool Windowed, bool PairGathers = true, class KeyFn,
+          class StressFn = NoStressUpdate>
 G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const GridView<D, Real>& grid,
                               const GridVelocity<D, Real>& velocities, const G2PParams& q,
                               const KeyFn& key_of, std::size_t begin, std::size_t end,
@@ -162,8 +275,9 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
   const GridVelocity<D, Real> V = velocities;
   G2PRangeResult r;
   const Real dt = Real(q.dt), flip = Real(q.flip), pic = Real(1) - Real(q.flip);
-  G2PGather<D, Shape, Real, Windowed> st(G);
-  typename G2PGather<D, Shape, Real, Windowed>::Held held;
+  using Gather = G2PGather<D, Shape, Real, Windowed, PairGathers>;
+  Gather st(G);
+  typename Gather::Held held;
   constexpr bool kScatter = (What & kScatterMomentum) != 0;
   static_assert((What & kStressUpdate) == 0 || (What & kVelocityGradient) != 0,
                 "the stress update needs the velocity gradient");
@@ -174,7 +288,7 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
   Block block;
   const auto off =
       Windowed ? Window<D, Shape, Real>::offsets(G) : typename Window<D, Shape, Real>::Offsets{};
-  using Weights = typename G2PGather<D, Shape, Real, Windowed>::Weights;
+  using Weights = typename Gather::Weights;
   // When the momentum block and the gather's sums (2D vectors) do not fit in
   // the registers together (3D uGIMP and B-splines in double: 27 + 6), the
   // momenta of a batch are scattered after its gathers, by GroupedScatter
@@ -191,13 +305,16 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
   std::conditional_t<kDefer, GroupedScatter<D, Shape, Real, kMomentumOnly, false, kDeferUG>,
                      NoDeferred>
       deferred(G);
-  auto momentum_source = [&](std::size_t p) __attribute__((always_inline)) {
-    return scatter_source<D, Real, kMomentumOnly, false>(P, P2GOptions{}, Real(1), p);
+  // m and m v of particle p (the momentum pass has no force terms).
+  auto fill_momentum_source = [&](ScatterSource<D, Real> & s, std::size_t p)
+      __attribute__((always_inline)) {
+    fill_scatter_source<D, Real, kMomentumOnly, false>(s, P, P2GOptions{}, Real(1), p);
   };
   auto scatter_momentum = [&](const Weights& w, std::size_t p, std::size_t fo)
       __attribute__((always_inline)) {
     if constexpr (kDefer) return;  // after the batch
-    const ScatterSource<D, Real> s = momentum_source(p);
+    ScatterSource<D, Real> s;
+    fill_momentum_source(s, p);
     if constexpr (Windowed) {
       block.at(w.base + fo, G, off);
       block.accumulate(w, s);
@@ -208,9 +325,42 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
       }
     }
   };
+  // With kPairs the batch's gathers run right after its windows are built,
+  // two particles of one window at a time (G2PGather::gather_pair), into
+  // these arrays; the particles' updates then read them. The gathers read
+  // only the grid, so running them first changes nothing. Entries a pass
+  // does not gather stay 0, as gather()'s zeroed locals.
+  constexpr bool kPairs = Gather::kPairs;
+  constexpr bool kMotion = (What & kUpdateMotion) != 0, kGradient = (What & kVelocityGradient) != 0;
+  struct Gathered {
+    Real vn[kWeightBatch][D] = {}, dv[kWeightBatch][D] = {}, L[kWeightBatch][D * D] = {};
+    std::size_t first = 0;
+  };
+  struct NoGathered {};
+  std::conditional_t<kPairs, Gathered, NoGathered> gathered;
   auto build = [&](std::size_t first, std::size_t n, Weights * w, bool* ok)
       __attribute__((always_inline)) {
     st.build_batch(P, first, n, w, ok);
+    if constexpr (kPairs) {
+      gathered.first = first;
+      for (std::size_t i = 0; i < n;) {
+        if (!ok[i]) {
+          ++i;
+          continue;
+        }
+        const std::size_t b = w[i].base + field_offset<MultiField>(P, G, first + i);
+        if (i + 1 < n && ok[i + 1] &&
+            w[i + 1].base + field_offset<MultiField>(P, G, first + i + 1) == b) {
+          st.template gather_pair<kMotion, kGradient>(w[i], w[i + 1], V, b, held, gathered.vn + i,
+                                                      gathered.dv + i, gathered.L + i);
+          i += 2;
+        } else {
+          st.template gather<kMotion, kGradient>(w[i], V, b - w[i].base, held, gathered.vn[i],
+                                                 gathered.dv[i], gathered.L[i]);
+          i += 1;
+        }
+      }
+    }
   };
   auto transfer = [&](std::size_t p, const Weights* weights) __attribute__((always_inline)) {
     if (!weights) {
@@ -223,11 +373,17 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
       if constexpr (kScatter) scatter_momentum(w, p, fo);
       return true;
     }
-    Real vn[D] = {}, dv[D] = {}, L[D * D] = {};
-    st.template gather<(What & kUpdateMotion) != 0, (What & kVelocityGradient) != 0>(w, V, fo, held,
-                                                                                     vn, dv, L);
-    detail::update_particle<D, Real, What, Traction, Gravity>(P, q, dt, flip, pic, p, vn, dv, L, r,
-                                                              stress);
+    if constexpr (kPairs) {
+      (void)fo;  // read above only by the momentum scatter
+      const std::size_t i = p - gathered.first;
+      detail::update_particle<D, Real, What, Traction, Gravity>(
+          P, q, dt, flip, pic, p, gathered.vn[i], gathered.dv[i], gathered.L[i], r, stress);
+    } else {
+      Real vn[D] = {}, dv[D] = {}, L[D * D] = {};
+      st.template gather<kMotion, kGradient>(w, V, fo, held, vn, dv, L);
+      detail::update_particle<D, Real, What, Traction, Gravity>(P, q, dt, flip, pic, p, vn, dv, L,
+                                                                r, stress);
+    }
     if constexpr (kScatter) scatter_momentum(w, p, fo);
     return true;
   };
@@ -242,11 +398,9 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
       for (; count < n && ok[count]; ++count) {
         const std::size_t p = first + count;
         base[count] = w[count].base + field_offset<MultiField>(P, G, p);
-        fill_scatter_source<D, Real, kMomentumOnly, false>(sources[count], P, P2GOptions{}, Real(1),
-                                                          p);
+        fill_momentum_source(sources[count], p);
       }
-      const ScatterSource<D, Real>* s = sources.data();
-      deferred.add(w, base, s, count, count == n && first + n < end);
+      deferred.add(w, base, sources.data(), count, count == n && first + n < end);
     }
   };
   for_each_weighted<Weights>(begin, end, build, transfer, after_batch);

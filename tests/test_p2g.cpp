@@ -979,6 +979,185 @@ TYPED_TEST(P2G, WindowedGatherMatchesPointwiseAtGridEdges) {
   check_window_g2p<TypeParam::D, typename TypeParam::Shape, typename TypeParam::Real>(true, 502);
 }
 
+// Two particles per vector in the 3D double gathers (G2PGather::gather_pair,
+// AVX-512 builds): each particle of a pair gets the one-particle gather's
+// bits, in every pass's mix of sums (motion, gradient, both); and a G2P
+// range gives the same bits when its start moves by one particle, so that
+// other particles pair up (as when a thread's range starts elsewhere).
+// Particles come in runs of 1-5 within 0.42 h of one node, in one field,
+// so the runs share windows; grid 13 x 12 x 11 cells, 2 fields, random
+// grid velocities.
+template <class Shape>
+Particles<3, double> node_runs(const Grid<3, double>& g, std::size_t n, unsigned seed) {
+  auto p = random_particles<3, double>(g.G, g.cells, n, seed);
+  std::mt19937_64 rng(seed + 7);
+  std::uniform_real_distribution<double> U(0.0, 1.0);
+  std::size_t i = 0;
+  int field = 0;
+  while (i < n) {
+    const std::size_t run = std::min<std::size_t>(n - i, 1 + std::size_t(U(rng) * 5));
+    double centre[3];
+    for (int d = 0; d < 3; ++d) {
+      const int node = 3 + int(U(rng) * (g.cells[std::size_t(d)] - 6));
+      centre[d] = double(g.G.origin[d]) + (node + 0.6 * (U(rng) - 0.5)) * double(g.G.h[d]);
+    }
+    for (std::size_t k = 0; k < run; ++k, ++i) {
+      for (int d = 0; d < 3; ++d) p.x[d][i] = centre[d] + 0.24 * (U(rng) - 0.5) * double(g.G.h[d]);
+      p.field[i] = std::uint8_t(field);
+    }
+    field ^= 1;
+  }
+  return p;
+}
+
+template <class Shape, bool Motion, bool Gradient>
+void check_pair_gather_bits(unsigned seed) {
+  using Gather = G2PGather<3, Shape, double, true>;
+  if constexpr (!Gather::kPairs) {
+    GTEST_SKIP() << "the pair gather needs AVX-512";
+  } else {
+    const bool gimp = std::string(Shape::name) == "gimp";
+    Grid<3, double> g(grid_cells<3>(), 2);
+    RandomGridVelocity<3, double> gv(g.G.nodes * 2, seed);
+    const std::size_t n = 600;
+    auto p = node_runs<Shape>(g, n, seed);
+    const auto P = p.view(gimp);
+    const Gather st(g.G);
+    std::vector<typename Gather::Weights> w(n);
+    for (std::size_t i = 0; i < n; ++i) ASSERT_TRUE(st.builder.build(P, i, w[i])) << i;
+    typename Gather::Held held_one, held_pair;
+    int pairs = 0;
+    for (std::size_t i = 0; i + 1 < n; ++i) {
+      const std::size_t fa = field_offset<true>(P, g.G, i), fb = field_offset<true>(P, g.G, i + 1);
+      if (w[i].base + fa != w[i + 1].base + fb) continue;
+      double vn1[2][3] = {}, dv1[2][3] = {}, L1[2][9] = {};
+      double vn2[2][3] = {}, dv2[2][3] = {}, L2[2][9] = {};
+      st.template gather<Motion, Gradient>(w[i], gv.V, fa, held_one, vn1[0], dv1[0], L1[0]);
+      st.template gather<Motion, Gradient>(w[i + 1], gv.V, fb, held_one, vn1[1], dv1[1], L1[1]);
+      st.template gather_pair<Motion, Gradient>(w[i], w[i + 1], gv.V, w[i].base + fa, held_pair,
+                                                vn2, dv2, L2);
+      EXPECT_EQ(std::memcmp(vn1, vn2, sizeof vn1), 0) << "v, pair at " << i;
+      EXPECT_EQ(std::memcmp(dv1, dv2, sizeof dv1), 0) << "dv, pair at " << i;
+      EXPECT_EQ(std::memcmp(L1, L2, sizeof L1), 0) << "L, pair at " << i;
+      if (Gradient) {
+        EXPECT_NE(L2[1][4], 0.0);
+      }
+      if (Motion) {
+        EXPECT_NE(vn2[1][2], 0.0);
+      }
+      ++pairs;
+    }
+    EXPECT_GT(pairs, 300);
+  }
+}
+
+template <class Shape>
+void check_pair_gather_range_start(unsigned seed) {
+  const bool gimp = std::string(Shape::name) == "gimp";
+  Grid<3, double> g(grid_cells<3>(), 2);
+  RandomGridVelocity<3, double> gv(g.G.nodes * 2, seed);
+  const std::size_t n = 600;
+  auto base = node_runs<Shape>(g, n, seed);
+  auto a = base, b = base;
+  std::array<std::vector<double>, 9> La, Lb;
+  for (auto& l : La) l.assign(n, 0);
+  for (auto& l : Lb) l.assign(n, 0);
+  auto Pa = a.view(gimp), Pb = b.view(gimp);
+  for (int c = 0; c < 9; ++c) Pa.L[c] = La[c].data(), Pb.L[c] = Lb[c].data();
+  G2PParams q;
+  q.dt = 0.01;
+  q.flip = 0.9;
+  constexpr unsigned What = kUpdateMotion | kVelocityGradient;
+  g2p_range<3, Shape, double, What, true, true, false>(Pa, g.G, gv.V, q, NoKeys{}, 0, n);
+  g2p_range<3, Shape, double, What, true, true, false>(Pb, g.G, gv.V, q, NoKeys{}, 0, 1);
+  g2p_range<3, Shape, double, What, true, true, false>(Pb, g.G, gv.V, q, NoKeys{}, 1, n);
+  for (int d = 0; d < 3; ++d) {
+    EXPECT_TRUE(bitwise_equal(a.v[d], b.v[d])) << "velocity " << d;
+    EXPECT_TRUE(bitwise_equal(a.x[d], b.x[d])) << "position " << d;
+  }
+  for (int c = 0; c < 9; ++c) EXPECT_TRUE(bitwise_equal(La[c], Lb[c])) << "L " << c;
+}
+
+// The whole G2P range with pairs (the solver's) and without
+// (PairGathers = false) gives the same bits for each pass's mix of work:
+// USL's (motion and gradient), MUSL's first pass (motion, momentum
+// scattered after the batch) and its gradient pass (moving to x_next).
+template <class Shape, unsigned What>
+void check_pairs_match_one_per_vector(unsigned seed) {
+  const bool gimp = std::string(Shape::name) == "gimp";
+  Grid<3, double> ga(grid_cells<3>(), 2), gb(grid_cells<3>(), 2);
+  RandomGridVelocity<3, double> gv(ga.G.nodes * 2, seed);
+  const std::size_t n = 600;
+  auto a = node_runs<Shape>(ga, n, seed), b = a;
+  std::array<std::vector<double>, 9> La, Lb;
+  std::array<std::vector<double>, 3> xa, xb;
+  auto Pa = a.view(gimp), Pb = b.view(gimp);
+  for (int c = 0; c < 9; ++c) {
+    La[std::size_t(c)].assign(n, 0), Lb[std::size_t(c)].assign(n, 0);
+    Pa.L[c] = La[std::size_t(c)].data(), Pb.L[c] = Lb[std::size_t(c)].data();
+  }
+  for (int d = 0; d < 3; ++d) {
+    // x_next as MUSL's motion pass leaves it, for the gradient pass to commit.
+    xa[std::size_t(d)].assign(a.x[d].begin(), a.x[d].end()),
+        xb[std::size_t(d)] = xa[std::size_t(d)];
+    Pa.x_next[d] = xa[std::size_t(d)].data(), Pb.x_next[d] = xb[std::size_t(d)].data();
+  }
+  G2PParams q;
+  q.dt = 0.01;
+  q.flip = 0.9;
+  const auto ra = g2p_range_impl<3, Shape, double, What, true, true, false, true, true>(
+      Pa, ga.G, gv.V, q, NoKeys{}, 0, n);
+  const auto rb = g2p_range_impl<3, Shape, double, What, true, true, false, true, false>(
+      Pb, gb.G, gv.V, q, NoKeys{}, 0, n);
+  ASSERT_EQ(ra.bad, SIZE_MAX);
+  ASSERT_EQ(rb.bad, SIZE_MAX);
+  for (int d = 0; d < 3; ++d) {
+    EXPECT_TRUE(bitwise_equal(a.v[d], b.v[d])) << "velocity " << d;
+    EXPECT_TRUE(bitwise_equal(a.x[d], b.x[d])) << "position " << d;
+    EXPECT_TRUE(bitwise_equal(xa[std::size_t(d)], xb[std::size_t(d)])) << "x_next " << d;
+    EXPECT_TRUE(bitwise_equal(ga.arrays[std::size_t(1 + d)], gb.arrays[std::size_t(1 + d)]))
+        << "momentum " << d;
+  }
+  for (int c = 0; c < 9; ++c)
+    EXPECT_TRUE(bitwise_equal(La[std::size_t(c)], Lb[std::size_t(c)])) << "L " << c;
+  // Each pass changed something: the comparison is not of untouched arrays.
+  if constexpr ((What & kUpdateMotion) != 0) {
+    EXPECT_FALSE(bitwise_equal(a.v[0], node_runs<Shape>(ga, n, seed).v[0]));
+  }
+  if constexpr ((What & kVelocityGradient) != 0) {
+    EXPECT_NE(La[4][n / 2], 0.0);
+  }
+  if constexpr ((What & kScatterMomentum) != 0) {
+    EXPECT_NE(ga.sum(ga.G.p[1]), 0.0);
+  }
+}
+
+TEST(G2PPairGather, WholeRangeSameBitsWithAndWithoutPairs) {
+  constexpr unsigned kUsl = kUpdateMotion | kVelocityGradient;
+  constexpr unsigned kMuslMotion = kUpdateMotion | kScatterMomentum;
+  constexpr unsigned kMuslGradient = kVelocityGradient | kCommitPosition;
+  check_pairs_match_one_per_vector<GimpShape, kUsl>(721);
+  check_pairs_match_one_per_vector<GimpShape, kMuslMotion>(722);
+  check_pairs_match_one_per_vector<GimpShape, kMuslGradient>(723);
+  check_pairs_match_one_per_vector<BSpline2Shape, kUsl>(724);
+  check_pairs_match_one_per_vector<BSpline2Shape, kMuslMotion>(725);
+  check_pairs_match_one_per_vector<BSpline2Shape, kMuslGradient>(726);
+}
+
+TEST(G2PPairGather, SameBitsAsOneParticleGimp) {
+  check_pair_gather_bits<GimpShape, true, true>(711);
+  check_pair_gather_bits<GimpShape, true, false>(712);
+  check_pair_gather_bits<GimpShape, false, true>(713);
+}
+TEST(G2PPairGather, SameBitsAsOneParticleBSpline2) {
+  check_pair_gather_bits<BSpline2Shape, true, true>(714);
+  check_pair_gather_bits<BSpline2Shape, false, true>(715);
+}
+TEST(G2PPairGather, RangeStartChangesNoBit) {
+  check_pair_gather_range_start<GimpShape>(716);
+  check_pair_gather_range_start<BSpline2Shape>(717);
+}
+
 // MUSL's fused pass (G2P of the updated velocity + P2G of the new momentum,
 // kScatterMomentum) equals the two separate passes: the same velocities and
 // grid momentum bit for bit, end positions (x_next) to 2 ulp (x + dt v may
