@@ -979,6 +979,26 @@ TYPED_TEST(P2G, WindowedGatherMatchesPointwiseAtGridEdges) {
   check_window_g2p<TypeParam::D, typename TypeParam::Shape, typename TypeParam::Real>(true, 502);
 }
 
+// The velocity gradients and end positions two G2P kernels write, for two
+// copies a, b of one particle set: L zeroed; x_next starting at x (what a
+// motion pass wrote), given to the views only when x_next.
+template <int D, class Real>
+struct GatherOutputs {
+  std::array<std::vector<Real>, D * D> La, Lb;
+  std::array<std::vector<Real>, D> xa, xb;
+  GatherOutputs(const Particles<D, Real>& a, ParticleView<D, Real>& Pa, ParticleView<D, Real>& Pb,
+                bool x_next) {
+    for (std::size_t c = 0; c < std::size_t(D * D); ++c) {
+      La[c].assign(a.n, 0), Lb[c].assign(a.n, 0);
+      Pa.L[c] = La[c].data(), Pb.L[c] = Lb[c].data();
+    }
+    for (std::size_t d = 0; d < std::size_t(D); ++d) {
+      xa[d] = a.x[d], xb[d] = a.x[d];
+      if (x_next) Pa.x_next[d] = xa[d].data(), Pb.x_next[d] = xb[d].data();
+    }
+  }
+};
+
 // Two particles per vector in the 3D double gathers (G2PGather::gather_pair,
 // AVX-512 builds): each particle of a pair gets the one-particle gather's
 // bits, in every pass's mix of sums (motion, gradient, both); and a G2P
@@ -1089,19 +1109,10 @@ void check_pairs_match_one_per_vector(unsigned seed) {
   RandomGridVelocity<3, double> gv(ga.G.nodes * 2, seed);
   const std::size_t n = 600;
   auto a = node_runs<Shape>(ga, n, seed), b = a;
-  std::array<std::vector<double>, 9> La, Lb;
-  std::array<std::vector<double>, 3> xa, xb;
   auto Pa = a.view(gimp), Pb = b.view(gimp);
-  for (int c = 0; c < 9; ++c) {
-    La[std::size_t(c)].assign(n, 0), Lb[std::size_t(c)].assign(n, 0);
-    Pa.L[c] = La[std::size_t(c)].data(), Pb.L[c] = Lb[std::size_t(c)].data();
-  }
-  for (int d = 0; d < 3; ++d) {
-    // x_next as MUSL's motion pass leaves it, for the gradient pass to commit.
-    xa[std::size_t(d)].assign(a.x[d].begin(), a.x[d].end()),
-        xb[std::size_t(d)] = xa[std::size_t(d)];
-    Pa.x_next[d] = xa[std::size_t(d)].data(), Pb.x_next[d] = xb[std::size_t(d)].data();
-  }
+  // x_next as MUSL's motion pass leaves it, for the gradient pass to commit.
+  GatherOutputs<3, double> out(a, Pa, Pb, true);
+  const auto& [La, Lb, xa, xb] = out;
   G2PParams q;
   q.dt = 0.01;
   q.flip = 0.9;
@@ -1258,17 +1269,9 @@ void check_packed_gather(Particles<2, Real> a, std::size_t bad, bool x_next, uns
   RandomGridVelocity<2, Real> gv(g.G.nodes * 2, seed);
   const std::size_t n = a.n;
   auto b = a;
-  std::array<std::vector<Real>, 4> La, Lb;
-  std::array<std::vector<Real>, 2> xa, xb;
   auto Pa = a.view(false), Pb = b.view(false);
-  for (int c = 0; c < 4; ++c) {
-    La[std::size_t(c)].assign(n, 0), Lb[std::size_t(c)].assign(n, 0);
-    Pa.L[c] = La[std::size_t(c)].data(), Pb.L[c] = Lb[std::size_t(c)].data();
-  }
-  for (int d = 0; d < 2; ++d) {
-    xa[std::size_t(d)] = a.x[d], xb[std::size_t(d)] = b.x[d];  // what a motion pass wrote
-    if (x_next) Pa.x_next[d] = xa[std::size_t(d)].data(), Pb.x_next[d] = xb[std::size_t(d)].data();
-  }
+  GatherOutputs<2, Real> out(a, Pa, Pb, x_next);
+  auto& [La, Lb, xa, xb] = out;
   // Float: both kernels keep the positions' low parts (kernels/
   // position_sum.hpp), from the same random start within half an ulp.
   std::array<std::vector<Real>, 2> loa, lob;
