@@ -438,14 +438,15 @@ std::size_t colored_tiles(const TileSchedule& S, std::size_t n, const Range& ran
 
 // (a) The solver's colored scatter (Stepper::p2g), each tile added straight
 // into the grid. Windowed = false runs the pointwise reference kernel in the
-// same tiles.
+// same tiles; Units, the windowed block's vector layout (RowUnits: the
+// one-row units the two-row scatter units replaced, kernels/window.hpp).
 template <int D, class Shape, class Real, unsigned What, bool MultiField, bool Traction,
-          bool Windowed = true>
+          bool Windowed = true, class Units = ScatterUnits<D, Shape, Real>>
 std::size_t p2g_colored(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
                         const P2GOptions& opt, const Binning<D, Real>& B) {
   return colored_tiles(B.schedule, P.n, [&](std::size_t b, std::size_t e) {
     const std::size_t r =
-        Windowed ? p2g_range<D, Shape, Real, What, MultiField, Traction>(P, G, opt, b, e)
+        Windowed ? p2g_range<D, Shape, Real, What, MultiField, Traction, Units>(P, G, opt, b, e)
                  : p2g_range_pointwise<D, Shape, Real, What, MultiField, Traction>(P, G, opt, b, e);
     return r == e ? SIZE_MAX : r;
   });

@@ -19,8 +19,18 @@ namespace {
 
 // colored / serial: the solver's windowed kernel (kernels/window.hpp);
 // colored_pointwise / serial_pointwise: the reference kernel that adds every
-// particle into its stencil node by node (the scatter before the window).
-enum class Strategy { colored, serial, atomic, colored_pointwise, serial_pointwise };
+// particle into its stencil node by node (the scatter before the window);
+// colored_row_units: the windowed kernel with one window row per vector unit
+// (RowUnits), registered where the solver's units (ScatterUnits) take two
+// rows: 3D uGIMP and quadratic B-splines in double.
+enum class Strategy {
+  colored,
+  serial,
+  atomic,
+  colored_pointwise,
+  serial_pointwise,
+  colored_row_units
+};
 
 const char* strategy_name(Strategy s) {
   switch (s) {
@@ -34,6 +44,8 @@ const char* strategy_name(Strategy s) {
       return "colored_pointwise";
     case Strategy::serial_pointwise:
       return "serial_pointwise";
+    case Strategy::colored_row_units:
+      return "colored_row_units";
   }
   return "?";
 }
@@ -103,6 +115,10 @@ void bm_p2g(benchmark::State& state, Strategy strategy, int tile, int threads) {
       case Strategy::atomic:
         bad = p2g_atomic<D, Shape, Real>(P, G);
         break;
+      case Strategy::colored_row_units:
+        bad = p2g_colored<D, Shape, Real, What, false, false, true, RowUnits<D, Shape, Real>>(
+            P, G, opt, fx.bins);
+        break;
     }
     keep(bad);
     keep(G.m);
@@ -136,7 +152,8 @@ void register_case() {
                            "/real:" + real_name<Real>() + "/strategy:";
   auto add = [&](Strategy s, int tile, int threads) {
     std::string name = base + strategy_name(s);
-    if (s == Strategy::colored || s == Strategy::colored_pointwise)
+    if (s == Strategy::colored || s == Strategy::colored_pointwise ||
+        s == Strategy::colored_row_units)
       name += "/tile:" + std::to_string(tile);
     name += "/threads:" + std::to_string(threads);
     auto* b = benchmark::RegisterBenchmark(name.c_str(), [s, tile, threads](benchmark::State& st) {
@@ -153,6 +170,10 @@ void register_case() {
   add(Strategy::serial_pointwise, T, 1);
   add(Strategy::colored_pointwise, T, 1);
   add(Strategy::colored_pointwise, T, 2);
+  if constexpr (!std::is_same_v<ScatterUnits<D, Shape, Real>, RowUnits<D, Shape, Real>>) {
+    add(Strategy::colored_row_units, T, 1);
+    add(Strategy::colored_row_units, T, 2);
+  }
 }
 
 // Tile edge sweep of the colored scatter (the solver's default is 8 in 2D, 4 in

@@ -228,6 +228,28 @@ def p2g_section(R):
                 rows.append([dim + "D", shape, real, fmt(s1), fmt(c1), fmt(c2), ratio(c1, c2), fmt(ps1),
                              fmt(pc1), fmt(pc2), ratio(pc1, c1), fmt(a2), ratio(a2, c2), fmt(gf), fmt(gb)])
     out.append(table(header, rows))
+    # Where the solver's block units take two window rows (3D uGIMP and
+    # quadratic B-splines in double): the one-row units, this run.
+    rows = []
+    for dim in ("2", "3"):
+        tile = "16" if dim == "2" else "8"
+        for real in ("double", "float"):
+            for shape in SHAPES:
+                get = lambda strat, th: R.value("p2g", ns, dim=dim, shape=shape, real=real,
+                                                strategy=strat, threads=th, tile=tile)
+                r1, r2 = get("colored_row_units", 1), get("colored_row_units", 2)
+                if r1 is None and r2 is None:
+                    continue
+                c1, c2 = get("colored", 1), get("colored", 2)
+                rows.append([dim + "D", shape, real, fmt(c1), fmt(r1), ratio(r1, c1), fmt(c2), fmt(r2),
+                             ratio(r2, c2)])
+    if rows:
+        out += ["", "### Two window rows per vector unit vs one (colored windowed, ns/particle)", "",
+                "Windows binned by the nearest node have 9 rows of 4 nodes; the solver's scatter "
+                "blocks take 2 rows per AVX-512 vector (5 units, the last padded), the baseline one "
+                "row (9 half-register units). Bitwise the same grid (tests/test_p2g.cpp).", ""]
+        out.append(table(["dim", "shape", "real", "2 rows 1t", "1 row 1t", "1 row / 2 rows (1t)",
+                          "2 rows 2t", "1 row 2t", "1 row / 2 rows (2t)"], rows))
     out += ["", "### Tile edge of the colored scatter (ns/particle; best per row in bold)", "",
             "TileLayout rounds the tile edge up to a power of two of at least 4, so an edge of 3 "
             "is not available; 32 is measured instead. In 3D the 36³ grid has only 2 tiles of 32 "

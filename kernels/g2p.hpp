@@ -295,9 +295,11 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
   // (kernels/window_block.hpp), from the same windows: the same sums in the
   // same order. A particle off the grid ends the batch's scatter there (the
   // step fails on it anyway).
-  constexpr int kUnits = Window<D, Shape, Real>::units;
+  // (Counted in the gathers' one-row units: the deferral was chosen, and
+  // measured, before the scatters' units took two rows.)
+  using Rows = RowUnits<D, Shape, Real>;
   constexpr bool kDefer =
-      kScatter && Windowed && D * kUnits + 2 * D > block_register_budget<D, Shape, Real>();
+      kScatter && Windowed && D * Rows::units + 2 * D > block_register_budget<typename Rows::V>();
   constexpr int kDeferUG = block_group_units<D, Shape, Real, kMomentumOnly, false>();
   struct NoDeferred {
     explicit NoDeferred(const GridView<D, Real>&) {}

@@ -86,7 +86,8 @@ std::size_t p2g_range_pointwise(const ParticleView<D, Real>& P, const GridView<D
 // particle then loaded and stored every sum (3D uGIMP double P2G 80 -> 67-75
 // ns/particle). Bitwise the one-block sums. The caller has checked
 // Window::fits. Returns as p2g_range.
-template <int D, class Shape, class Real, unsigned What, bool MultiField, bool Traction, int UG>
+template <int D, class Shape, class Real, unsigned What, bool MultiField, bool Traction, int UG,
+          class Units = ScatterUnits<D, Shape, Real>>
 std::size_t p2g_range_grouped(const ParticleView<D, Real>& particles, const GridView<D, Real>& grid,
                               const P2GOptions& opt, std::size_t begin, std::size_t end) {
   const ParticleView<D, Real> P = particles;
@@ -94,7 +95,7 @@ std::size_t p2g_range_grouped(const ParticleView<D, Real>& particles, const Grid
   using Win = Window<D, Shape, Real>;
   const Real inv_t = Real(opt.inv_thickness);
   const WindowBuilder<D, Shape, Real> builder(G);
-  GroupedScatter<D, Shape, Real, What, Traction, UG> scatter(G);
+  GroupedScatter<D, Shape, Real, What, Traction, UG, Units> scatter(G);
   Win w[kWeightBatch];
   ScatterSource<D, Real> q[kWeightBatch];
   std::size_t base[kWeightBatch];
@@ -117,7 +118,8 @@ std::size_t p2g_range_grouped(const ParticleView<D, Real>& particles, const Grid
 
 // The windowed scatter with one block for the whole window (its sums fit in
 // the registers). The caller has checked Window::fits. Returns as p2g_range.
-template <int D, class Shape, class Real, unsigned What, bool MultiField, bool Traction>
+template <int D, class Shape, class Real, unsigned What, bool MultiField, bool Traction,
+          class Units = ScatterUnits<D, Shape, Real>>
 std::size_t p2g_range_one_block(const ParticleView<D, Real>& particles,
                                 const GridView<D, Real>& grid, const P2GOptions& opt,
                                 std::size_t begin, std::size_t end) {
@@ -126,7 +128,7 @@ std::size_t p2g_range_one_block(const ParticleView<D, Real>& particles,
   const ParticleView<D, Real> P = particles;
   const GridView<D, Real> G = grid;
   using Win = Window<D, Shape, Real>;
-  using Block = WindowBlock<D, Shape, Real, What, Traction>;
+  using Block = WindowBlock<D, Shape, Real, What, Traction, Units::units, Units>;
   const Real inv_t = Real(opt.inv_thickness);
   const auto off = Win::offsets(G);
   Block block;
@@ -152,21 +154,26 @@ std::size_t p2g_range_one_block(const ParticleView<D, Real>& particles,
 // into a local block, which goes to the grid when the window changes. Same
 // sums as p2g_range_pointwise, in a different order (round-off level).
 // 2D linear with AVX-512 packs 2 or 4 particles per vector
-// (kernels/p2g_packed.hpp). Scatters particles [begin, end); returns the
-// first particle whose stencil leaves the grid, or end.
-template <int D, class Shape, class Real, unsigned What, bool MultiField, bool Traction>
+// (kernels/p2g_packed.hpp). Units: the block's vector layout
+// (kernels/window.hpp; RowUnits is the benchmarks' baseline). Scatters
+// particles [begin, end); returns the first particle whose stencil leaves
+// the grid, or end.
+template <int D, class Shape, class Real, unsigned What, bool MultiField, bool Traction,
+          class Units = ScatterUnits<D, Shape, Real>>
 std::size_t p2g_range(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
                       const P2GOptions& opt, std::size_t begin, std::size_t end) {
   using Win = Window<D, Shape, Real>;
   if (!Win::fits(G))
     return p2g_range_pointwise<D, Shape, Real, What, MultiField, Traction>(P, G, opt, begin, end);
-  constexpr int UG = block_group_units<D, Shape, Real, What, Traction>();
+  constexpr int UG = block_group_units<D, Shape, Real, What, Traction, Units>();
   if constexpr (packed_particles<D, Shape, Real>() > 1)
     return p2g_range_packed<Real, What, MultiField, Traction>(P, G, opt, begin, end);
-  else if constexpr (UG < Win::units)
-    return p2g_range_grouped<D, Shape, Real, What, MultiField, Traction, UG>(P, G, opt, begin, end);
+  else if constexpr (UG < Units::units)
+    return p2g_range_grouped<D, Shape, Real, What, MultiField, Traction, UG, Units>(P, G, opt,
+                                                                                    begin, end);
   else
-    return p2g_range_one_block<D, Shape, Real, What, MultiField, Traction>(P, G, opt, begin, end);
+    return p2g_range_one_block<D, Shape, Real, What, MultiField, Traction, Units>(P, G, opt, begin,
+                                                                                  end);
 }
 
 }  // namespace mmpm

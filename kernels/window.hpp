@@ -73,8 +73,13 @@ constexpr int window_rows_per_unit(int rows, int cap) {
   return ru;
 }
 
+template <class Win, int RowsPerUnit>
+struct WindowUnits;
+
 template <int D, class Shape, class Real>
 struct Window {
+  static constexpr int dim = D;
+  using RealType = Real;
   static constexpr int W = Shape::W;  // nodes per row (x)
   // Rows per y and z direction (header comment).
   static constexpr int WY = binned_by_nearest_node<D, Shape, Real> ? 3 : W;
@@ -120,6 +125,51 @@ struct Window {
     return off;
   }
 
+  // Grid values of unit u and their sum with v written back; the lane
+  // vectors of the header comment (WindowUnits below, RU rows per unit).
+  template <int u>
+  static V load(const Real* a, const Offsets& off) {
+    return WindowUnits<Window, RU>::template load<u>(a, off);
+  }
+  template <int u>
+  static void add(Real* a, const Offsets& off, const V& v) {
+    WindowUnits<Window, RU>::template add<u>(a, off, v);
+  }
+  V X() const { return WindowUnits<Window, RU>::X(*this); }
+  V GX() const { return WindowUnits<Window, RU>::GX(*this); }
+  template <int u>
+  V Y() const {
+    return WindowUnits<Window, RU>::template Y<u>(*this);
+  }
+  template <int u>
+  V GY() const {
+    return WindowUnits<Window, RU>::template GY<u>(*this);
+  }
+  template <int u>
+  V GZ() const {
+    return WindowUnits<Window, RU>::template GZ<u>(*this);
+  }
+};
+
+// A window's nodes as vector units of RU rows of W nodes (lane k of unit u:
+// x node k % W, row u * RU + k / W). Window uses the most rows per unit that
+// divide its rows evenly, because the gathers sum across a unit's lanes.
+// The scatters only add lane by lane, so they may pad (ScatterUnits below):
+// rows past the window's last (R) are loaded as zeros, get the last row's
+// weights (finite, never used) and are never stored. Every real lane gets
+// the same operations either way, so the grid gets the same bits.
+template <class Win, int RowsPerUnit>
+struct WindowUnits {
+  using Real = typename Win::RealType;
+  static constexpr int D = Win::dim, W = Win::W, WY = Win::WY, R = Win::R;
+  static constexpr int RU = RowsPerUnit;
+  static constexpr int L = W * RU;                 // lanes per unit
+  static constexpr int units = (R + RU - 1) / RU;  // the last one padded when RU does not divide R
+  using V = Lanes<Real, L>;
+  using Row = Lanes<Real, W>;
+  using VA = typename Win::VA;
+  using Offsets = typename Win::Offsets;
+
   // Grid values of unit u (rows are unaligned: windows start at any node),
   // rows joined with shuffles, not through memory.
   template <int u>
@@ -130,35 +180,38 @@ struct Window {
   static void add(Real* a, const Offsets& off, const V& v) {
     const V sum = load<u>(a, off) + v;
     static_for<RU>([&](auto k) __attribute__((always_inline)) {
-      lanes_store(a + off[std::size_t(u * RU + k)], row_of<k>(sum, std::make_index_sequence<W>{}));
+      constexpr int row = u * RU + decltype(k)::value;
+      if constexpr (row < R)
+        lanes_store(a + off[std::size_t(row)],
+                    row_of<decltype(k)::value>(sum, std::make_index_sequence<W>{}));
     });
   }
 
-  // The lane vectors of the header comment (lane k of unit u: x node k % W,
-  // row u * RU + k / W).
-  V X() const {
-    return pick(wa, [](int k) { return k % W; });
+  static V X(const Win& w) {
+    return pick(w.wa, [](int k) { return k % W; });
   }
-  V GX() const {
-    return pick(dwa, [](int k) { return k % W; });
+  static V GX(const Win& w) {
+    return pick(w.dwa, [](int k) { return k % W; });
   }
   template <int u>
-  V Y() const {
-    return yz<u>(wa, wa);
+  static V Y(const Win& w) {
+    return yz<u>(w.wa, w.wa);
   }
   template <int u>
-  V GY() const {
-    return yz<u>(dwa, wa);
+  static V GY(const Win& w) {
+    return yz<u>(w.dwa, w.wa);
   }
   template <int u>
-  V GZ() const {
+  static V GZ(const Win& w) {
     if constexpr (D == 2)
       return V{};
     else
-      return yz<u>(wa, dwa);
+      return yz<u>(w.wa, w.dwa);
   }
 
  private:
+  // Window row of lane k of unit u (padding rows take the last row's).
+  static constexpr int row(int u, int k) { return std::min(u * RU + k / W, R - 1); }
   // Lanes of a picked by a constexpr index function of the unit lane.
   template <class F>
   static V pick(const VA& a, F f) {
@@ -167,19 +220,22 @@ struct Window {
   // Product of the y factor (from ya) and the z factor (from za) of unit u.
   template <int u>
   static V yz(const VA& ya, const VA& za) {
-    constexpr auto jy = [](int k) { return W + (u * RU + k / W) % WY; };
+    constexpr auto jy = [](int k) { return W + row(u, k) % WY; };
     if constexpr (D == 2) {
       return pick(ya, jy);
     } else {
-      constexpr auto lz = [](int k) { return 2 * W + (u * RU + k / W) / WY; };
+      constexpr auto lz = [](int k) { return 2 * W + row(u, k) / WY; };
       return pick(ya, jy) * pick(za, lz);
     }
   }
-  // Rows first .. first + count - 1 joined into one vector.
+  // Rows first .. first + count - 1 joined into one vector (zeros past R).
   template <int first, int count>
   static Lanes<Real, W * count> join(const Real* a, const Offsets& off) {
     if constexpr (count == 1) {
-      return lanes_load<Row>(a + off[std::size_t(first)]);
+      if constexpr (first < R)
+        return lanes_load<Row>(a + off[std::size_t(first)]);
+      else
+        return Row{};
     } else {
       const auto lo = join<first, count / 2>(a, off);
       const auto hi = join<first + count / 2, count / 2>(a, off);
@@ -196,6 +252,25 @@ struct Window {
     return __builtin_shufflevector(v, v, int(k * W + I)...);
   }
 };
+
+// Rows per unit of the scatters: the most that fill at most `cap` (64
+// bytes' worth), as a power of two, whether or not they divide the rows.
+// 3D uGIMP and quadratic B-splines in double (9 rows of 4 nodes): 5 units
+// of 2 rows, one AVX-512 register each, where Window has 9 of one row, half
+// a register (docs/performance.md "Two rows per unit in the 3D scatter").
+constexpr int scatter_rows_per_unit(int rows, int cap) {
+  int ru = 1;
+  while (2 * ru <= cap && 2 * ru <= rows) ru *= 2;
+  return ru;
+}
+template <int D, class Shape, class Real>
+using ScatterUnits =
+    WindowUnits<Window<D, Shape, Real>, scatter_rows_per_unit(Window<D, Shape, Real>::R,
+                                                              64 / int(Shape::W * sizeof(Real)))>;
+// Window's own units (one row per unit in the case above): the scatters'
+// baseline in the benchmarks and tests.
+template <int D, class Shape, class Real>
+using RowUnits = WindowUnits<Window<D, Shape, Real>, Window<D, Shape, Real>::RU>;
 
 // Builds particles' windows on one grid (the grid's constants are kept here,
 // once, not in every Window of a batch, kernels/weight_batch.hpp).

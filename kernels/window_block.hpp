@@ -87,15 +87,19 @@ template <bool MultiField, int D, class Real>
   return MultiField ? std::size_t(P.field[p]) * G.nodes : 0;
 }
 
-// Sums for UG units of the window (all of them by default); the member
-// templates take the first unit U0 of the group (GroupedScatter below splits
-// the window into groups when one block would not fit in the registers).
+// Sums for UG units of the window (all of them by default), units as Units
+// lays them out (kernels/window.hpp: ScatterUnits, or RowUnits, the
+// benchmarks' baseline); the member templates take the first unit U0 of the
+// group (GroupedScatter below splits the window into groups when one block
+// would not fit in the registers; the last group may hold fewer units).
 template <int D, class Shape, class Real, unsigned What, bool Traction,
-          int UG = Window<D, Shape, Real>::units>
+          int UG = ScatterUnits<D, Shape, Real>::units, class Units = ScatterUnits<D, Shape, Real>>
 struct WindowBlock {
   using Win = Window<D, Shape, Real>;
-  using V = typename Win::V;
+  using V = typename Units::V;
   static constexpr int U = UG;
+  // Units of the group starting at window unit U0.
+  static constexpr int count(int U0) { return U0 + U <= Units::units ? U : Units::units - U0; }
   static constexpr bool kMass = (What & kMassMomentum) != 0;
   static constexpr bool kMom = (What & (kMassMomentum | kMomentumOnly)) != 0;
   static constexpr bool kFrc = (What & kForce) != 0;
@@ -128,16 +132,16 @@ struct WindowBlock {
   void flush(const GridView<D, Real>& G, const typename Win::Offsets& off) {
     if (current == SIZE_MAX) return;
     const std::size_t b = current;
-    static_for<U>([&](auto uc) __attribute__((always_inline)) {
+    static_for<count(U0)>([&](auto uc) __attribute__((always_inline)) {
       constexpr int u = decltype(uc)::value, wu = U0 + u;  // block unit, window unit
-      if constexpr (kMass) Win::template add<wu>(G.m + b, off, am[u]);
+      if constexpr (kMass) Units::template add<wu>(G.m + b, off, am[u]);
       for (int d = 0; d < D; ++d) {
-        if constexpr (kMom) Win::template add<wu>(G.p[d] + b, off, ap[d][u]);
-        if constexpr (kFrc) Win::template add<wu>(G.f[d] + b, off, af[d][u]);
-        if constexpr (kMM) Win::template add<wu>(G.mx[d] + b, off, amx[d][u]);
-        if constexpr (kGrad) Win::template add<wu>(G.g[d] + b, off, ag[d][u]);
+        if constexpr (kMom) Units::template add<wu>(G.p[d] + b, off, ap[d][u]);
+        if constexpr (kFrc) Units::template add<wu>(G.f[d] + b, off, af[d][u]);
+        if constexpr (kMM) Units::template add<wu>(G.mx[d] + b, off, amx[d][u]);
+        if constexpr (kGrad) Units::template add<wu>(G.g[d] + b, off, ag[d][u]);
       }
-      if constexpr (kMM) Win::template add<wu>(G.vol + b, off, avol[u]);
+      if constexpr (kMM) Units::template add<wu>(G.vol + b, off, avol[u]);
     });
   }
 
@@ -154,12 +158,12 @@ struct WindowBlock {
 
   template <int U0 = 0>
   void accumulate(const Win& win, const ScatterSource<D, Real>& q) {
-    const V X = win.X(), GXl = win.GX();
-    static_for<U>([&](auto uc) __attribute__((always_inline)) {
+    const V X = Units::X(win), GXl = Units::GX(win);
+    static_for<count(U0)>([&](auto uc) __attribute__((always_inline)) {
       constexpr int u = decltype(uc)::value, wu = U0 + u;  // block unit, window unit
-      const V Yu = win.template Y<wu>();
+      const V Yu = Units::template Y<wu>(win);
       const V s = X * Yu;
-      const V Gx = GXl * Yu, Gy = X * win.template GY<wu>();
+      const V Gx = GXl * Yu, Gy = X * Units::template GY<wu>(win);
       if constexpr (kMass) am[u] += s * q.m;
       if constexpr (kMom)
         for (int d = 0; d < D; ++d) ap[d][u] += s * q.mv[d];
@@ -169,7 +173,7 @@ struct WindowBlock {
           af[0][u] -= q.vs[0] * Gx + q.vs[2] * Gy;
           af[1][u] -= q.vs[2] * Gx + q.vs[1] * Gy;
         } else {
-          const V Gz = X * win.template GZ<wu>();
+          const V Gz = X * Units::template GZ<wu>(win);
           af[0][u] -= q.vs[0] * Gx + q.vs[5] * Gy + q.vs[4] * Gz;
           af[1][u] -= q.vs[5] * Gx + q.vs[1] * Gy + q.vs[3] * Gz;
           af[2][u] -= q.vs[4] * Gx + q.vs[3] * Gy + q.vs[2] * Gz;
@@ -184,7 +188,7 @@ struct WindowBlock {
       if constexpr (kGrad) {
         ag[0][u] += Gx * q.area;
         ag[1][u] += Gy * q.area;
-        if constexpr (D == 3) ag[2][u] += (X * win.template GZ<wu>()) * q.area;
+        if constexpr (D == 3) ag[2][u] += (X * Units::template GZ<wu>(win)) * q.area;
       }
     });
   }
@@ -199,26 +203,27 @@ inline constexpr int kVectorBytes = 64;
 inline constexpr int kVectorRegisters = 12;
 inline constexpr int kVectorBytes = 32;
 #endif
-// The same budget in window units (a unit of 64 bytes is two AVX2
+// The same budget in vectors of type V (one of 64 bytes is two AVX2
 // registers; one of 32 bytes, a row of 4 doubles, is one register either way).
-template <int D, class Shape, class Real>
+template <class V>
 constexpr int block_register_budget() {
-  constexpr int bytes = int(sizeof(typename Window<D, Shape, Real>::V));
+  constexpr int bytes = int(sizeof(V));
   return kVectorRegisters / (bytes > kVectorBytes ? bytes / kVectorBytes : 1);
 }
 
-// Units per block group: all of the window's units when their sums fit in
-// the registers, else the largest divisor of the units that does (3D uGIMP
-// and B-splines in double: 64 nodes x 7 quantities = 56 vectors of 8 lanes,
-// 2 groups; binned by the nearest node, kernels/shape.hpp: 9 units x 7 =
-// 63 vectors of 4 lanes, 3 groups).
-template <int D, class Shape, class Real, unsigned What, bool Traction>
+// Units per block group: all of the scatter's units when their sums fit in
+// the registers, else as few groups as fit, of equal size but for a smaller
+// last one (3D uGIMP and B-splines in double: 64 nodes x 7 quantities = 56
+// vectors of 8 lanes, 2 groups of 4; binned by the nearest node,
+// kernels/shape.hpp: 5 units of 2 rows x 7 = 35 vectors, groups of 3 and 2).
+template <int D, class Shape, class Real, unsigned What, bool Traction,
+          class Units = ScatterUnits<D, Shape, Real>>
 constexpr int block_group_units() {
-  constexpr int q = WindowBlock<D, Shape, Real, What, Traction, 1>::kQuantities;
-  constexpr int units = Window<D, Shape, Real>::units;
-  int g = units;
-  while (g > 1 && (g * q > block_register_budget<D, Shape, Real>() || units % g != 0)) --g;
-  return g;
+  constexpr int q = WindowBlock<D, Shape, Real, What, Traction, 1, Units>::kQuantities;
+  constexpr int units = Units::units;
+  constexpr int fit = block_register_budget<typename Units::V>() / q;
+  constexpr int groups = fit < 1 ? units : (units + fit - 1) / fit;
+  return (units + groups - 1) / groups;
 }
 
 // Scatters windows a batch at a time with the window's units in groups of
@@ -229,13 +234,13 @@ constexpr int block_group_units() {
 // units: bitwise equal results (tests/test_p2g.cpp). Scattering group by
 // group over a whole batch instead would reorder the adds of overlapping
 // windows.
-template <int D, class Shape, class Real, unsigned What, bool Traction, int UG>
+template <int D, class Shape, class Real, unsigned What, bool Traction, int UG,
+          class Units = ScatterUnits<D, Shape, Real>>
 class GroupedScatter {
  public:
   using Win = Window<D, Shape, Real>;
-  using Block = WindowBlock<D, Shape, Real, What, Traction, UG>;
-  static constexpr int kGroups = Win::units / UG;
-  static_assert(kGroups * UG == Win::units);
+  using Block = WindowBlock<D, Shape, Real, What, Traction, UG, Units>;
+  static constexpr int kGroups = (Units::units + UG - 1) / UG;  // the last one may be short
 
   explicit GroupedScatter(const GridView<D, Real>& G) : G_(G), off_(Win::offsets(G)) {}
 

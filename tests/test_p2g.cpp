@@ -733,6 +733,26 @@ TYPED_TEST(P2G, WindowedScatterMatchesPointwiseAtGridEdgesUnsorted) {
                                                                                       402);
 }
 
+// Two scatters, first(P, G, opt, n) and second(...), of particle set p into
+// fresh grids: the same stopping particle, every grid array bitwise equal.
+template <int D, class Shape, class Real, class First, class Second>
+void expect_same_scatter_bits(Particles<D, Real> p, std::size_t stop_at, const std::string& what,
+                              First first, Second second) {
+  const bool gimp = std::string(Shape::name) == "gimp";
+  Grid<D, Real> one(grid_cells<D>(), 2), two(grid_cells<D>(), 2);
+  const auto P = p.view(gimp);
+  P2GOptions opt;
+  opt.inv_thickness = 0.5;
+  const std::size_t n = p.n, expect = std::min(stop_at, n);
+  ASSERT_EQ(first(P, one.G, opt, n), expect) << what;
+  ASSERT_EQ(second(P, two.G, opt, n), expect) << what;
+  for (std::size_t a = 0; a < one.arrays.size(); ++a)
+    for (std::size_t i = 0; i < one.arrays[a].size(); ++i)
+      ASSERT_EQ(std::memcmp(&one.arrays[a][i], &two.arrays[a][i], sizeof(Real)), 0)
+          << what << ", array " << a << ", entry " << i << ": " << double(one.arrays[a][i])
+          << " vs " << double(two.arrays[a][i]);
+}
+
 // The grouped scatter (GroupedScatter, kernels/window_block.hpp: the
 // window's units in groups of UG, each run of particles with one window
 // scattered group by group, a run cut by a batch's end carried into the
@@ -742,21 +762,15 @@ TYPED_TEST(P2G, WindowedScatterMatchesPointwiseAtGridEdgesUnsorted) {
 // batch). Also stops at the same particle off the grid, with the sums
 // before it.
 template <int D, class Shape, class Real, unsigned What, bool MF, bool TR, int UG>
-void check_grouped_matches_one_block(Particles<D, Real> p, std::size_t stop_at) {
-  const bool gimp = std::string(Shape::name) == "gimp";
-  Grid<D, Real> one(grid_cells<D>(), 2), grouped(grid_cells<D>(), 2);
-  const auto P = p.view(gimp);
-  P2GOptions opt;
-  opt.inv_thickness = 0.5;
-  const std::size_t n = p.n;
-  const std::size_t expect = std::min(stop_at, n);
-  ASSERT_EQ((p2g_range_one_block<D, Shape, Real, What, MF, TR>(P, one.G, opt, 0, n)), expect);
-  ASSERT_EQ((p2g_range_grouped<D, Shape, Real, What, MF, TR, UG>(P, grouped.G, opt, 0, n)), expect);
-  for (std::size_t a = 0; a < one.arrays.size(); ++a)
-    for (std::size_t i = 0; i < one.arrays[a].size(); ++i)
-      ASSERT_EQ(std::memcmp(&one.arrays[a][i], &grouped.arrays[a][i], sizeof(Real)), 0)
-          << "UG " << UG << ", What " << What << ", array " << a << ", entry " << i << ": "
-          << double(one.arrays[a][i]) << " vs " << double(grouped.arrays[a][i]);
+void check_grouped_matches_one_block(const Particles<D, Real>& p, std::size_t stop_at) {
+  expect_same_scatter_bits<D, Shape, Real>(
+      p, stop_at, "UG " + std::to_string(UG) + ", What " + std::to_string(What),
+      [](const auto& P, const auto& G, const P2GOptions& opt, std::size_t n) {
+        return p2g_range_one_block<D, Shape, Real, What, MF, TR>(P, G, opt, 0, n);
+      },
+      [](const auto& P, const auto& G, const P2GOptions& opt, std::size_t n) {
+        return p2g_range_grouped<D, Shape, Real, What, MF, TR, UG>(P, G, opt, 0, n);
+      });
 }
 
 template <int D, class Shape, class Real, int UG>
@@ -769,40 +783,93 @@ void check_grouped_all_quantities(const Particles<D, Real>& p, std::size_t stop_
   check_grouped_matches_one_block<D, Shape, Real, kMomentumOnly, true, false, UG>(p, stop_at);
 }
 
+// The particle sets of the block comparisons (grouped, two-row and packed
+// scatters, packed gathers): random particles in tile order (2 fields, runs
+// of 1-6 per cell; 6000 in 2D, 4000 in 3D), 100 particles of field
+// `crowded_field` in one cell (a run across 4 batches of 32), and the sorted
+// set with particle `bad` off the grid.
+template <int D, class Shape, class Real>
+struct BlockTestSets {
+  static constexpr std::size_t bad = 1235;
+  Grid<D, Real> g{grid_cells<D>(), 2};
+  Particles<D, Real> sorted, crowded, off_grid;
+  BlockTestSets(unsigned seed, std::uint8_t crowded_field) {
+    TileLayout<D> tiles;
+    tiles.setup(4, g.cells);
+    auto random = random_particles<D, Real>(g.G, g.cells, D == 2 ? 6000 : 4000, seed);
+    sorted = random.permuted(sort_by_tile<Shape>(random, g.G, tiles));
+    crowded = random_particles<D, Real>(g.G, g.cells, 100, seed + 1);
+    for (std::size_t i = 0; i < crowded.n; ++i) {
+      crowded.field[i] = crowded_field;
+      for (int d = 0; d < D; ++d)
+        crowded.x[d][i] =
+            Real(double(g.G.origin[d]) + (5.3 + 0.4 * double(i % 7) / 7.0) * double(g.G.h[d]));
+    }
+    off_grid = sorted;
+    off_grid.x[1][bad] = Real(1e6);
+  }
+  // f(list, the particle the kernels must stop at or SIZE_MAX).
+  template <class F>
+  void each(F&& f) const {
+    f(sorted, SIZE_MAX);
+    f(crowded, SIZE_MAX);
+    f(off_grid, bad);
+  }
+};
+template <class Real>
+using PackedTestSets = BlockTestSets<2, LinearShape, Real>;
+
 TYPED_TEST(P2G, GroupedScatterGivesTheOneBlockSumsBitwise) {
   constexpr int D = TypeParam::D;
   using Shape = typename TypeParam::Shape;
   using Real = typename TypeParam::Real;
-  constexpr int U = Window<D, Shape, Real>::units;
-  Grid<D, Real> g(grid_cells<D>(), 2);
-  TileLayout<D> tiles;
-  tiles.setup(4, g.cells);
-  auto random = random_particles<D, Real>(g.G, g.cells, D == 2 ? 6000 : 4000, 901);
-  auto sorted = random.permuted(sort_by_tile<Shape>(random, g.G, tiles));
-  // 100 particles of field 1 in one cell: one run of 100.
-  auto crowded = random_particles<D, Real>(g.G, g.cells, 100, 902);
-  for (std::size_t i = 0; i < crowded.n; ++i) {
-    crowded.field[i] = 1;
-    for (int d = 0; d < D; ++d)
-      crowded.x[d][i] =
-          Real(double(g.G.origin[d]) + (5.3 + 0.4 * double(i % 7) / 7.0) * double(g.G.h[d]));
-  }
-  // The same list with one particle moved off the grid: both kernels stop there.
-  auto off_grid = sorted;
-  const std::size_t bad = 1234;
-  off_grid.x[0][bad] = Real(-1e6);
-  for (const auto* list : {&sorted, &crowded, &off_grid}) {
-    const std::size_t stop_at = list == &off_grid ? bad : SIZE_MAX;
-    check_grouped_all_quantities<D, Shape, Real, 1>(*list, stop_at);
-    // Groups of every proper divisor of U that is > 1, and of 1 (windows
-    // binned by the nearest node have 9 units; the others powers of two).
-    if constexpr (U >= 2) check_grouped_all_quantities<D, Shape, Real, 1>(*list, stop_at);
-    if constexpr (U % 2 == 0 && U >= 4)
-      check_grouped_all_quantities<D, Shape, Real, U / 2>(*list, stop_at);
-    if constexpr (U % 2 == 0 && U >= 8)
-      check_grouped_all_quantities<D, Shape, Real, 2>(*list, stop_at);
-    if constexpr (U % 3 == 0 && U >= 6)
-      check_grouped_all_quantities<D, Shape, Real, U / 3>(*list, stop_at);
+  constexpr int U = ScatterUnits<D, Shape, Real>::units;
+  const BlockTestSets<D, Shape, Real> sets(901, 1);
+  sets.each([](const Particles<D, Real>& list, std::size_t stop_at) {
+    // Groups of 1, 2 and 3 units: with 5 units (3D uGIMP and quadratic
+    // B-splines in double) 2 and 3 leave a short last group, as do 3 of 4
+    // and 3 of 8.
+    check_grouped_all_quantities<D, Shape, Real, 1>(list, stop_at);
+    if constexpr (U > 2) check_grouped_all_quantities<D, Shape, Real, 2>(list, stop_at);
+    if constexpr (U > 3) check_grouped_all_quantities<D, Shape, Real, 3>(list, stop_at);
+  });
+}
+
+// The scatters' units of two rows (ScatterUnits, kernels/window.hpp: 3D
+// uGIMP and quadratic B-splines in double, 5 units with a padded last one)
+// against Window's one-row units (RowUnits): every grid array bitwise the
+// same, for every quantity set the solver scatters, through p2g_range as the
+// solver calls it (grouped blocks), and the same stopping particle. Cases
+// where the two layouts are the same type are skipped.
+template <int D, class Shape, class Real, unsigned What, bool MF, bool TR>
+void check_scatter_units_match_rows(const Particles<D, Real>& p, std::size_t stop_at) {
+  expect_same_scatter_bits<D, Shape, Real>(
+      p, stop_at, "What " + std::to_string(What),
+      [](const auto& P, const auto& G, const P2GOptions& opt, std::size_t n) {
+        return p2g_range<D, Shape, Real, What, MF, TR, RowUnits<D, Shape, Real>>(P, G, opt, 0, n);
+      },
+      [](const auto& P, const auto& G, const P2GOptions& opt, std::size_t n) {
+        return p2g_range<D, Shape, Real, What, MF, TR>(P, G, opt, 0, n);
+      });
+}
+
+TYPED_TEST(P2G, TwoRowScatterUnitsGiveTheOneRowSumsBitwise) {
+  constexpr int D = TypeParam::D;
+  using Shape = typename TypeParam::Shape;
+  using Real = typename TypeParam::Real;
+  if constexpr (std::is_same_v<ScatterUnits<D, Shape, Real>, RowUnits<D, Shape, Real>>) {
+    GTEST_SKIP() << "one layout";
+  } else {
+    static_assert(ScatterUnits<D, Shape, Real>::units < RowUnits<D, Shape, Real>::units);
+    const BlockTestSets<D, Shape, Real> sets(905, 1);
+    sets.each([](const Particles<D, Real>& list, std::size_t stop_at) {
+      check_scatter_units_match_rows<D, Shape, Real, kAll, true, true>(list, stop_at);
+      check_scatter_units_match_rows<D, Shape, Real, kMassMomentum | kForce, false, false>(list,
+                                                                                           stop_at);
+      check_scatter_units_match_rows<D, Shape, Real, kMultimaterial | kDomainGradient, true, false>(
+          list, stop_at);
+      check_scatter_units_match_rows<D, Shape, Real, kMomentumOnly, true, false>(list, stop_at);
+    });
   }
 }
 
@@ -831,32 +898,6 @@ void check_packed_matches_one_block(Particles<2, Real> p, std::size_t stop_at) {
     EXPECT_LE(rel, tol) << "What " << What << ", array " << a;
   }
 }
-
-// The particle sets of the packed-kernel tests: 6000 random particles in
-// tile order (2 fields, runs of 1-6 per cell), 100 particles of field
-// `crowded_field` in one cell (a run across 4 batches of 32), and the
-// sorted set with particle `bad` off the grid.
-template <class Real>
-struct PackedTestSets {
-  static constexpr std::size_t bad = 1235;
-  Grid<2, Real> g{grid_cells<2>(), 2};
-  Particles<2, Real> sorted, crowded, off_grid;
-  PackedTestSets(unsigned seed, std::uint8_t crowded_field) {
-    TileLayout<2> tiles;
-    tiles.setup(4, g.cells);
-    auto random = random_particles<2, Real>(g.G, g.cells, 6000, seed);
-    sorted = random.permuted(sort_by_tile<LinearShape>(random, g.G, tiles));
-    crowded = random_particles<2, Real>(g.G, g.cells, 100, seed + 1);
-    for (std::size_t i = 0; i < crowded.n; ++i) {
-      crowded.field[i] = crowded_field;
-      for (int d = 0; d < 2; ++d)
-        crowded.x[d][i] =
-            Real(double(g.G.origin[d]) + (5.3 + 0.4 * double(i % 7) / 7.0) * double(g.G.h[d]));
-    }
-    off_grid = sorted;
-    off_grid.x[1][bad] = Real(1e6);
-  }
-};
 
 template <class Real>
 void check_packed_all_quantities() {
@@ -1007,7 +1048,6 @@ struct GatherOutputs {
 // Particles come in runs of 1-5 within 0.42 h of one node, in one field,
 // so the runs share windows; grid 13 x 12 x 11 cells, 2 fields, random
 // grid velocities.
-template <class Shape>
 Particles<3, double> node_runs(const Grid<3, double>& g, std::size_t n, unsigned seed) {
   auto p = random_particles<3, double>(g.G, g.cells, n, seed);
   std::mt19937_64 rng(seed + 7);
@@ -1040,7 +1080,7 @@ void check_pair_gather_bits(unsigned seed) {
     Grid<3, double> g(grid_cells<3>(), 2);
     RandomGridVelocity<3, double> gv(g.G.nodes * 2, seed);
     const std::size_t n = 600;
-    auto p = node_runs<Shape>(g, n, seed);
+    auto p = node_runs(g, n, seed);
     const auto P = p.view(gimp);
     const Gather st(g.G);
     std::vector<typename Gather::Weights> w(n);
@@ -1077,13 +1117,10 @@ void check_pair_gather_range_start(unsigned seed) {
   Grid<3, double> g(grid_cells<3>(), 2);
   RandomGridVelocity<3, double> gv(g.G.nodes * 2, seed);
   const std::size_t n = 600;
-  auto base = node_runs<Shape>(g, n, seed);
+  auto base = node_runs(g, n, seed);
   auto a = base, b = base;
-  std::array<std::vector<double>, 9> La, Lb;
-  for (auto& l : La) l.assign(n, 0);
-  for (auto& l : Lb) l.assign(n, 0);
   auto Pa = a.view(gimp), Pb = b.view(gimp);
-  for (int c = 0; c < 9; ++c) Pa.L[c] = La[c].data(), Pb.L[c] = Lb[c].data();
+  GatherOutputs<3, double> out(a, Pa, Pb, false);
   G2PParams q;
   q.dt = 0.01;
   q.flip = 0.9;
@@ -1095,7 +1132,7 @@ void check_pair_gather_range_start(unsigned seed) {
     EXPECT_TRUE(bitwise_equal(a.v[d], b.v[d])) << "velocity " << d;
     EXPECT_TRUE(bitwise_equal(a.x[d], b.x[d])) << "position " << d;
   }
-  for (int c = 0; c < 9; ++c) EXPECT_TRUE(bitwise_equal(La[c], Lb[c])) << "L " << c;
+  for (int c = 0; c < 9; ++c) EXPECT_TRUE(bitwise_equal(out.La[c], out.Lb[c])) << "L " << c;
 }
 
 // The whole G2P range with pairs (the solver's) and without
@@ -1108,7 +1145,7 @@ void check_pairs_match_one_per_vector(unsigned seed) {
   Grid<3, double> ga(grid_cells<3>(), 2), gb(grid_cells<3>(), 2);
   RandomGridVelocity<3, double> gv(ga.G.nodes * 2, seed);
   const std::size_t n = 600;
-  auto a = node_runs<Shape>(ga, n, seed), b = a;
+  auto a = node_runs(ga, n, seed), b = a;
   auto Pa = a.view(gimp), Pb = b.view(gimp);
   // x_next as MUSL's motion pass leaves it, for the gradient pass to commit.
   GatherOutputs<3, double> out(a, Pa, Pb, true);
@@ -1133,7 +1170,7 @@ void check_pairs_match_one_per_vector(unsigned seed) {
     EXPECT_TRUE(bitwise_equal(La[std::size_t(c)], Lb[std::size_t(c)])) << "L " << c;
   // Each pass changed something: the comparison is not of untouched arrays.
   if constexpr ((What & kUpdateMotion) != 0) {
-    EXPECT_FALSE(bitwise_equal(a.v[0], node_runs<Shape>(ga, n, seed).v[0]));
+    EXPECT_FALSE(bitwise_equal(a.v[0], node_runs(ga, n, seed).v[0]));
   }
   if constexpr ((What & kVelocityGradient) != 0) {
     EXPECT_NE(La[4][n / 2], 0.0);
