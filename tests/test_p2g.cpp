@@ -903,17 +903,15 @@ template <class Real>
 void check_packed_all_quantities() {
   static_assert(packed_particles<2, LinearShape, Real>() > 1);
   const PackedTestSets<Real> t(911, 1);
-  const std::size_t bad = t.bad;
-  for (const auto* list : {&t.sorted, &t.crowded, &t.off_grid}) {
-    const std::size_t stop_at = list == &t.off_grid ? bad : SIZE_MAX;
-    check_packed_matches_one_block<Real, kAll, true, true>(*list, stop_at);
-    check_packed_matches_one_block<Real, kMassMomentum | kForce, false, false>(*list, stop_at);
-    check_packed_matches_one_block<Real, kMassMomentum | kForce, true, true>(*list, stop_at);
-    check_packed_matches_one_block<Real, kMassMomentum, false, false>(*list, stop_at);
-    check_packed_matches_one_block<Real, kForce, true, false>(*list, stop_at);
-    check_packed_matches_one_block<Real, kMultimaterial, true, false>(*list, stop_at);
-    check_packed_matches_one_block<Real, kMomentumOnly, true, false>(*list, stop_at);
-  }
+  t.each([](const Particles<2, Real>& list, std::size_t stop_at) {
+    check_packed_matches_one_block<Real, kAll, true, true>(list, stop_at);
+    check_packed_matches_one_block<Real, kMassMomentum | kForce, false, false>(list, stop_at);
+    check_packed_matches_one_block<Real, kMassMomentum | kForce, true, true>(list, stop_at);
+    check_packed_matches_one_block<Real, kMassMomentum, false, false>(list, stop_at);
+    check_packed_matches_one_block<Real, kForce, true, false>(list, stop_at);
+    check_packed_matches_one_block<Real, kMultimaterial, true, false>(list, stop_at);
+    check_packed_matches_one_block<Real, kMomentumOnly, true, false>(list, stop_at);
+  });
 }
 
 #ifdef __AVX512F__
