@@ -112,31 +112,46 @@ void bm_g2p(benchmark::State& state, int threads) {
 
 // MUSL's fused pass (G2P of the updated velocity + P2G of m v into the
 // zeroed grid momentum, kUpdateMotion | kScatterMomentum), colored tile by
-// tile as the Stepper runs it. Solver = true: g2p_range, the solver's
-// choice (packed in 2D linear, kernels/g2p_packed.hpp; pairs of particles
-// per vector in 3D double); false: the one-particle windowed kernel, the
-// baseline in the same run.
-template <int D, class Shape, class Real, bool Solver>
+// tile as the Stepper runs it. solver: g2p_range, the solver's choice
+// (packed in 2D linear, kernels/g2p_packed.hpp; pairs of particles per
+// vector in 3D double); one_particle: the one-particle windowed kernel, the
+// baseline in the same run; inline_block / after_batch: the solver's
+// gathers with the momenta scattered where named (MomentumScatterAt), both
+// measured where the solver picks between them (3D double).
+enum class Fused { solver, one_particle, inline_block, after_batch };
+
+template <int D, class Shape, class Real, Fused Kernel, class KeyFn>
+G2PRangeResult fused_range(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
+                           const GridVelocity<D, Real>& V, const G2PParams& q, const KeyFn& key_of,
+                           std::size_t b, std::size_t e) {
+  constexpr unsigned What = kUpdateMotion | kScatterMomentum;
+  if constexpr (Kernel == Fused::solver)
+    return g2p_range<D, Shape, Real, What, false, false, false>(P, G, V, q, key_of, b, e);
+  else if constexpr (Kernel == Fused::one_particle)
+    return g2p_range_impl<D, Shape, Real, What, false, false, false, true, false>(P, G, V, q,
+                                                                                  key_of, b, e);
+  else
+    return g2p_range_impl < D, Shape, Real, What, false, false, false, true, true,
+           Kernel == Fused::inline_block
+               ? MomentumScatterAt::inline_block
+               : MomentumScatterAt::after_batch > (P, G, V, q, key_of, b, e);
+}
+
+template <int D, class Shape, class Real, Fused Kernel>
 void bm_g2p_fused(benchmark::State& state, int threads) {
   use_threads(threads);
   auto& fx = g2p_fixture<D, Shape, Real>();
   const ParticleView<D, Real>& P = fx.S.P;
   const GridView<D, Real>& G = fx.grid.G;
   const GridVelocity<D, Real>& V = fx.grid.V;
-  constexpr unsigned What = kUpdateMotion | kScatterMomentum;
   const G2PParams q = g2p_bench_params();
   const auto key_of = PositionTile<D, Real>::of(fx.bins.tiles, fx.bins.origin, G.h, P.x);
   std::size_t bad = SIZE_MAX;
   for (auto _ : state) {
     for (int d = 0; d < D; ++d) std::fill(G.p[d], G.p[d] + G.nodes, Real(0));
-    bad = std::min(
-        bad, colored_tiles(fx.bins.schedule, P.n, [&](std::size_t b, std::size_t e) {
-          return (Solver ? g2p_range<D, Shape, Real, What, false, false, false>(P, G, V, q, key_of,
-                                                                                b, e)
-                         : g2p_range_impl<D, Shape, Real, What, false, false, false, true, false>(
-                               P, G, V, q, key_of, b, e))
-              .bad;
-        }));
+    bad = std::min(bad, colored_tiles(fx.bins.schedule, P.n, [&](std::size_t b, std::size_t e) {
+                     return fused_range<D, Shape, Real, Kernel>(P, G, V, q, key_of, b, e).bad;
+                   }));
     keep(G.p[0]);
     benchmark::ClobberMemory();
   }
@@ -215,22 +230,27 @@ void register_g2p_case() {
   register_g2p_kernel<D, Shape, Real, Gather::pointwise>("g2p_pointwise");
 }
 
+template <int D, class Shape, class Real, Fused Kernel>
+void register_g2p_fused_kernel(const char* kernel) {
+  for (int threads : {1, 2}) {
+    const std::string name = std::string("g2p_fused/dim:") + std::to_string(D) +
+                             "/shape:" + Shape::name + "/real:" + real_name<Real>() +
+                             "/kernel:" + kernel + "/threads:" + std::to_string(threads);
+    auto* b = benchmark::RegisterBenchmark(name.c_str(), [threads](benchmark::State& st) {
+      bm_g2p_fused<D, Shape, Real, Kernel>(st, threads);
+    });
+    configure(b->UseRealTime()->Unit(benchmark::kMillisecond), 0.1);
+  }
+}
+
 template <int D, class Shape, class Real>
 void register_g2p_fused_case() {
-  for (const bool solver : {true, false})
-    for (int threads : {1, 2}) {
-      const std::string name = std::string("g2p_fused/dim:") + std::to_string(D) +
-                               "/shape:" + Shape::name + "/real:" + real_name<Real>() +
-                               "/kernel:" + (solver ? "solver" : "one_particle") +
-                               "/threads:" + std::to_string(threads);
-      auto* b = benchmark::RegisterBenchmark(name.c_str(), [threads, solver](benchmark::State& st) {
-        if (solver)
-          bm_g2p_fused<D, Shape, Real, true>(st, threads);
-        else
-          bm_g2p_fused<D, Shape, Real, false>(st, threads);
-      });
-      configure(b->UseRealTime()->Unit(benchmark::kMillisecond), 0.1);
-    }
+  register_g2p_fused_kernel<D, Shape, Real, Fused::solver>("solver");
+  register_g2p_fused_kernel<D, Shape, Real, Fused::one_particle>("one_particle");
+  if constexpr (D == 3) {
+    register_g2p_fused_kernel<D, Shape, Real, Fused::inline_block>("inline_block");
+    register_g2p_fused_kernel<D, Shape, Real, Fused::after_batch>("after_batch");
+  }
 }
 
 template <int D, class Real>

@@ -280,7 +280,9 @@ def kernel_section(R):
            "as the Stepper runs it (packed for 2D linear, windowed for the other shapes); "
            "pointwise = the node-by-node reference gather. MUSL fused G2P+P2G: MUSL's first "
            "particle pass (G2P of the new velocity, then P2G of m v with the same window), colored "
-           "as in the step; its reference column is the one-particle windowed kernel. "
+           "as in the step; its reference column is the one-particle windowed kernel; in 3D "
+           "also with the momenta scattered after each batch of 32 (GroupedScatter) instead of "
+           "in the block beside the gathers (the solver's choice where both fit the registers). "
               "G2P one particle per vector: the 3D double windowed gather without pairs of "
               "particles per 512-bit vector, the solver's baseline in the same run. "
            "Constitutive: isotropic small-strain "
@@ -317,6 +319,13 @@ def kernel_section(R):
                     continue
                 rows.append(["MUSL fused G2P+P2G", dim + "D", shape, real, fmt(v1), fmt(v2),
                              ratio(v1, v2), "–", fmt(o1) + " (one particle)", ratio(o1, v1)])
+                # 3D: the momenta scattered after each batch instead of in
+                # the block beside the gathers (the solver's choice there).
+                a1 = R.value("g2p_fused", ns, kernel="after_batch", threads=1, **want)
+                a2 = R.value("g2p_fused", ns, kernel="after_batch", threads=2, **want)
+                if a1 is not None or a2 is not None:
+                    rows.append(["MUSL fused, momenta after each batch", dim + "D", shape, real, fmt(a1),
+                                 fmt(a2), ratio(a1, a2), "–", "–", ratio(a1, v1) + " (vs solver)"])
             v1 = R.value("constitutive", ns, dim=dim, law="isotropic", real=real, threads=1)
             v2 = R.value("constitutive", ns, dim=dim, law="isotropic", real=real, threads=2)
             gb = R.value("constitutive", "particle_GBps", dim=dim, law="isotropic", real=real, threads=2)

@@ -259,10 +259,15 @@ struct G2PGather {
   }
 };
 
+// Where MUSL's fused pass scatters the momenta: the solver's choice
+// (automatic, below), in the block beside the gathers, or after each batch.
+enum class MomentumScatterAt { automatic, inline_block, after_batch };
+
 // PairGathers = false keeps the one-particle gather where pairs would run
 // (G2PGather::kPairs), the baseline bench/bench_g2p.cpp measures them against.
 template <int D, class Shape, class Real, unsigned What, bool MultiField, bool Traction,
-          bool Gravity, bool Windowed, bool PairGathers = true, class KeyFn,
+          bool Gravity, bool Windowed, bool PairGathers = true,
+          MomentumScatterAt ScatterAt = MomentumScatterAt::automatic, class KeyFn,
           class StressFn = NoStressUpdate>
 G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const GridView<D, Real>& grid,
                               const GridVelocity<D, Real>& velocities, const G2PParams& q,
@@ -290,16 +295,21 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
       Windowed ? Window<D, Shape, Real>::offsets(G) : typename Window<D, Shape, Real>::Offsets{};
   using Weights = typename Gather::Weights;
   // When the momentum block and the gather's sums (2D vectors) do not fit in
-  // the registers together (3D uGIMP and B-splines in double: 27 + 6), the
-  // momenta of a batch are scattered after its gathers, by GroupedScatter
-  // (kernels/window_block.hpp), from the same windows: the same sums in the
-  // same order. A particle off the grid ends the batch's scatter there (the
-  // step fails on it anyway).
-  // (Counted in the gathers' one-row units: the deferral was chosen, and
-  // measured, before the scatters' units took two rows.)
-  using Rows = RowUnits<D, Shape, Real>;
+  // the registers together (3D cubic B-splines in double: 8 units x 3 + 6),
+  // the momenta of a batch are scattered after its gathers, by
+  // GroupedScatter (kernels/window_block.hpp), from the same windows: the
+  // same sums in the same order. A particle off the grid ends the batch's
+  // scatter there (the step fails on it anyway). Counted in the block's own
+  // units (ScatterUnits: 3D uGIMP and quadratic B-splines in double, 5 x 3 +
+  // 6, stay inline: the 3D uGIMP step's G2P stage -5 to -10 % against
+  // deferred, docs/performance.md "MUSL's momenta scattered beside the
+  // gathers again").
+  using Scatter = ScatterUnits<D, Shape, Real>;
   constexpr bool kDefer =
-      kScatter && Windowed && D * Rows::units + 2 * D > block_register_budget<typename Rows::V>();
+      kScatter && Windowed &&
+      (ScatterAt == MomentumScatterAt::automatic
+           ? D * Scatter::units + 2 * D > block_register_budget<typename Scatter::V>()
+           : ScatterAt == MomentumScatterAt::after_batch);
   constexpr int kDeferUG = block_group_units<D, Shape, Real, kMomentumOnly, false>();
   struct NoDeferred {
     explicit NoDeferred(const GridView<D, Real>&) {}

@@ -1281,6 +1281,64 @@ TYPED_TEST(P2G, FusedMuslTransferMatchesSeparatePassesPointwise) {
   check_fused_musl<TypeParam::D, typename TypeParam::Shape, typename TypeParam::Real, false>(602);
 }
 
+// MUSL's fused pass scatters the momenta in a block beside the gathers or
+// after each batch (MomentumScatterAt; the solver picks by register count,
+// kernels/g2p.hpp): both are the same sums in the same order, so velocities
+// and grid momenta agree bit for bit, whichever the solver picks; end
+// positions to 2 ulp (x + dt v may or may not become one FMA in each
+// instantiation, as in check_fused_musl; 2D float differs there). On the
+// sorted and crowded sets of BlockTestSets (2 fields); with a particle off
+// the grid both stop at it (the deferred scatter then drops the rest of
+// that batch, so the momenta are not compared there).
+template <int D, class Shape, class Real>
+void check_momentum_scatter_placements(const Particles<D, Real>& list, std::size_t stop_at) {
+  const bool gimp = std::string(Shape::name) == "gimp";
+  Grid<D, Real> ga(grid_cells<D>(), 2), gb(grid_cells<D>(), 2);
+  RandomGridVelocity<D, Real> gv(ga.G.nodes * 2, 603);
+  auto a = list, b = list;
+  auto Pa = a.view(gimp), Pb = b.view(gimp);
+  const std::size_t n = list.n;
+  std::array<std::vector<Real>, D> xa, xb;
+  for (int d = 0; d < D; ++d) {
+    xa[d].assign(n, 0), xb[d].assign(n, 0);
+    Pa.x_next[d] = xa[d].data(), Pb.x_next[d] = xb[d].data();
+  }
+  G2PParams q;
+  q.dt = 0.01;
+  q.flip = 0.95;
+  constexpr unsigned What = kUpdateMotion | kScatterMomentum;
+  const auto ra =
+      g2p_range_impl<D, Shape, Real, What, true, false, false, true, true,
+                     MomentumScatterAt::inline_block>(Pa, ga.G, gv.V, q, NoKeys{}, 0, n);
+  const auto rb = g2p_range_impl<D, Shape, Real, What, true, false, false, true, true,
+                                 MomentumScatterAt::after_batch>(Pb, gb.G, gv.V, q, NoKeys{}, 0, n);
+  ASSERT_EQ(ra.bad, stop_at);
+  ASSERT_EQ(rb.bad, stop_at);
+  for (int d = 0; d < D; ++d) {
+    EXPECT_TRUE(bitwise_equal(a.v[d], b.v[d])) << "velocity " << d;
+    for (std::size_t i = 0; i < n; ++i)
+      ASSERT_LE(std::abs(double(xa[d][i]) - double(xb[d][i])),
+                2 * double(std::numeric_limits<Real>::epsilon()) * std::abs(double(xb[d][i])))
+          << "x_next " << d << " particle " << i;
+    if (stop_at == SIZE_MAX) {
+      EXPECT_EQ(first_difference(ga.arrays[std::size_t(1 + d)], gb.arrays[std::size_t(1 + d)]),
+                ga.arrays[std::size_t(1 + d)].size())
+          << "momentum " << d;
+    }
+  }
+  EXPECT_NE(ga.sum(ga.G.p[0]), 0.0);
+}
+
+TYPED_TEST(P2G, FusedMuslMomentumInlineOrAfterBatchSameBits) {
+  constexpr int D = TypeParam::D;
+  using Shape = typename TypeParam::Shape;
+  using Real = typename TypeParam::Real;
+  const BlockTestSets<D, Shape, Real> sets(604, 1);
+  sets.each([](const Particles<D, Real>& list, std::size_t stop_at) {
+    check_momentum_scatter_placements<D, Shape, Real>(list, stop_at);
+  });
+}
+
 // The packed 2D linear gather (kernels/g2p_packed.hpp, what g2p_range runs
 // for 2D linear) against the one-particle
 // windowed gather: the gathered values are the same operations in the same
