@@ -130,11 +130,12 @@ G2PRangeResult fused_range(const ParticleView<D, Real>& P, const GridView<D, Rea
   else if constexpr (Kernel == Fused::one_particle)
     return g2p_range_impl<D, Shape, Real, What, false, false, false, true, false>(P, G, V, q,
                                                                                   key_of, b, e);
-  else
-    return g2p_range_impl < D, Shape, Real, What, false, false, false, true, true,
-           Kernel == Fused::inline_block
-               ? MomentumScatterAt::inline_block
-               : MomentumScatterAt::after_batch > (P, G, V, q, key_of, b, e);
+  else {
+    constexpr MomentumScatterAt at = Kernel == Fused::inline_block ? MomentumScatterAt::inline_block
+                                                                   : MomentumScatterAt::after_batch;
+    return g2p_range_impl<D, Shape, Real, What, false, false, false, true, true, at>(P, G, V, q,
+                                                                                     key_of, b, e);
+  }
 }
 
 template <int D, class Shape, class Real, Fused Kernel>
