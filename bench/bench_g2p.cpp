@@ -277,6 +277,7 @@ void register_g2p() {
   register_g2p_fused_case<2, LinearShape, float>();
   register_g2p_fused_case<3, GimpShape, double>();
   register_g2p_fused_case<3, BSpline2Shape, double>();
+  register_g2p_fused_case<3, BSpline3Shape, double>();  // where the solver defers the momenta
   register_dim_real<2, double>();
   register_dim_real<2, float>();
   register_dim_real<3, double>();
