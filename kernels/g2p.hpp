@@ -153,6 +153,19 @@ struct G2PGather {
         }
       });
       const Vec X = w.X(), GX = w.GX();
+      if constexpr (D == 2 && (Ln == 8 || Ln == 16)) {
+        // The eight dot products of both directions in one shuffle tree:
+        // lanes_sum8 adds as the four-at-a-time branch below does, bit for
+        // bit, in fewer, whole-register shuffles.
+        const Vec parts[8] = {X * A[0], X * Q[0], GX * A[0], X * B[0],
+                              X * A[1], X * Q[1], GX * A[1], X * B[1]};
+        const Lanes<Real, 8> s = lanes_sum8<Real, Ln>(parts);
+        for (int d = 0; d < D; ++d) {
+          if constexpr (Motion) vn[d] = s[4 * d], dv[d] = s[4 * d + 1];
+          if constexpr (Gradient) L[d * D + 0] = s[4 * d + 2], L[d * D + 1] = s[4 * d + 3];
+        }
+        return;
+      }
       for (int d = 0; d < D; ++d) {
         if constexpr (Ln >= 4) {
           // Four dot products at once (a shuffle tree, not four serial sums).

@@ -105,4 +105,57 @@ inline V lanes_sum4(const V& a, const V& b, const V& c, const V& d) {
   return __builtin_shufflevector(ab, cd, 0, 1, 4, 5) + __builtin_shufflevector(ab, cd, 2, 3, 6, 7);
 }
 
+namespace detail {
+
+// One level of lanes_sum8's tree on two m-lane vectors p and q whose
+// segments of s lanes each hold the partial sums of one source: lane t of
+// the result (p's segments in its lower half, q's in its upper half, each
+// now s / 2 lanes long) adds two lanes of one segment. Halves = true pairs
+// lane k with lane k + s/2 (lanes_fold4's halves), false pairs lanes 2k and
+// 2k + 1 (lanes_sum4's pairs). First = true gives the first operand's lane.
+template <int m, int s, bool Halves, bool First>
+constexpr int sum8_lane(int t) {
+  const int from = t >= m / 2 ? m : 0;  // q's lanes follow p's in a shuffle
+  const int h = s / 2, j = (t % (m / 2)) / h, k = t % h;
+  return from + j * s + (Halves ? k + (First ? 0 : h) : 2 * k + (First ? 0 : 1));
+}
+template <int m, int s, class V, std::size_t... I>
+[[gnu::always_inline]] inline V sum8_level(const V& p, const V& q, std::index_sequence<I...>) {
+  constexpr bool halves = s > 4;
+  return __builtin_shufflevector(p, q, sum8_lane<m, s, halves, true>(int(I))...) +
+         __builtin_shufflevector(p, q, sum8_lane<m, s, halves, false>(int(I))...);
+}
+template <int m, int s, std::size_t K, class V>
+[[gnu::always_inline]] inline V sum8_tree(const V (&a)[K]) {
+  if constexpr (K == 1) {
+    return a[0];
+  } else {
+    V b[K / 2];
+    for (std::size_t k = 0; k < K / 2; ++k)
+      b[k] = sum8_level<m, s>(a[2 * k], a[2 * k + 1], std::make_index_sequence<m>{});
+    return sum8_tree<m, s / 2>(b);
+  }
+}
+
+}  // namespace detail
+
+// The lane sums of eight n-lane vectors (n = 8 or 16), {sum v[0], ...,
+// sum v[7]}, each bitwise lanes_sum4's sum of lanes_fold4 of it: the same
+// additions (halves down to 4 lanes, then (l0 + l1) + (l2 + l3)), done as
+// one shuffle tree across the eight vectors, so each shuffle and add works
+// on whole registers (2D G2P: 8 sums per particle; in float, 16 lanes,
+// 23 shuffles and adds where lanes_fold4 + lanes_sum4 took 50).
+template <class Real, int n, class V>
+[[gnu::always_inline]] inline Lanes<Real, 8> lanes_sum8(const V (&v)[8]) {
+  static_assert(n == 8 || n == 16, "lanes_sum8 takes vectors of 8 or 16 lanes");
+  const V t = detail::sum8_tree<n, n>(v);
+  if constexpr (n == 8) {
+    return t;
+  } else {
+    // 8 segments of 2 lanes left: (l0 + l1) + (l2 + l3)'s last add.
+    return __builtin_shufflevector(t, t, 0, 2, 4, 6, 8, 10, 12, 14) +
+           __builtin_shufflevector(t, t, 1, 3, 5, 7, 9, 11, 13, 15);
+  }
+}
+
 }  // namespace mmpm
