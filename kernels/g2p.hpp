@@ -260,14 +260,23 @@ struct G2PGather {
           L[k][d * D + 1] = s1[4 * k + 3];
         }
       }
-      if constexpr (Gradient) {
-        const V2 xc = X * C[d];
-        for (int k = 0; k < 2; ++k) {
-          Real sum = 0;  // lanes_sum's order
-          for (int l = 0; l < 4; ++l) sum += xc[4 * k + l];
-          L[k][d * D + 2] = sum;
-        }
-      }
+    }
+    if constexpr (Gradient) {
+      // L_d,z = lanes_sum(X C[d]) per particle: a serial sum from 0 (gather()'s
+      // order), for the 3 directions and 2 particles at once. Transposed by
+      // shuffles, lane 2d + k of the l-th vector added is lane l of particle
+      // k's X C[d], so each sum gets its lanes in lanes_sum's order (24 lane
+      // extracts and scalar adds were the alternative).
+      static_assert(D == 3);
+      const V2 xc0 = X * C[0], xc1 = X * C[1], xc2 = X * C[2];
+      V2 sum = V2{};
+      static_for<4>([&](auto lc) __attribute__((always_inline)) {
+        constexpr int l = decltype(lc)::value;
+        const V2 t01 = __builtin_shufflevector(xc0, xc1, l, 4 + l, 8 + l, 12 + l, l, l, l, l);
+        sum += __builtin_shufflevector(t01, xc2, 0, 1, 2, 3, 8 + l, 12 + l, 0, 0);
+      });
+      for (int d = 0; d < D; ++d)
+        for (int k = 0; k < 2; ++k) L[k][d * D + 2] = sum[2 * d + k];
     }
   }
 };
