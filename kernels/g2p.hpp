@@ -421,20 +421,17 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
     if constexpr (kScatter) scatter_momentum(w, p, fo);
     return true;
   };
-  // The deferred scatter's sources, filled in place batch by batch (zeroed
-  // once here, not once per batch).
+  // The deferred scatter's sources, field by field, filled batch by batch.
   struct NoSources {};
-  std::conditional_t<kDefer, std::array<ScatterSource<D, Real>, kWeightBatch>, NoSources> sources{};
+  std::conditional_t<kDefer, ScatterSourceBatch<D, Real>, NoSources> sources;
   auto after_batch = [&](std::size_t first, std::size_t n, const Weights* w, const bool* ok) {
     if constexpr (kDefer) {
       std::size_t base[kWeightBatch];
       std::size_t count = 0;
-      for (; count < n && ok[count]; ++count) {
-        const std::size_t p = first + count;
-        base[count] = w[count].base + field_offset<MultiField>(P, G, p);
-        fill_momentum_source(sources[count], p);
-      }
-      deferred.add(w, base, sources.data(), count, count == n && first + n < end);
+      for (; count < n && ok[count]; ++count)
+        base[count] = w[count].base + field_offset<MultiField>(P, G, first + count);
+      sources.template fill<kMomentumOnly, false>(P, P2GOptions{}, Real(1), first, count);
+      deferred.add(w, base, sources, count, count == n && first + n < end);
     }
   };
   for_each_weighted<Weights>(begin, end, build, transfer, after_batch);

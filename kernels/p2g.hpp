@@ -97,7 +97,7 @@ std::size_t p2g_range_grouped(const ParticleView<D, Real>& particles, const Grid
   const WindowBuilder<D, Shape, Real> builder(G);
   GroupedScatter<D, Shape, Real, What, Traction, UG, Units> scatter(G);
   Win w[kWeightBatch];
-  ScatterSource<D, Real> q[kWeightBatch];
+  ScatterSourceBatch<D, Real> q;
   std::size_t base[kWeightBatch];
   for (std::size_t first = begin; first < end; first += kWeightBatch) {
     const std::size_t n = std::min(kWeightBatch, end - first);
@@ -105,10 +105,9 @@ std::size_t p2g_range_grouped(const ParticleView<D, Real>& particles, const Grid
     builder.build_batch(P, first, n, w, inside);
     std::size_t ok = 0;
     while (ok < n && inside[ok]) ++ok;
-    for (std::size_t i = 0; i < ok; ++i) {
+    for (std::size_t i = 0; i < ok; ++i)
       base[i] = w[i].base + field_offset<MultiField>(P, G, first + i);
-      fill_scatter_source<D, Real, What, Traction>(q[i], P, opt, inv_t, first + i);
-    }
+    q.template fill<What, Traction>(P, opt, inv_t, first, ok);
     scatter.add(w, base, q, ok, ok == n && first + n < end);
     if (ok < n) return first + ok;  // nothing carried: `more` was false
   }

@@ -9,6 +9,7 @@
 #include "kernels/grid_view.hpp"
 #include "kernels/particle_view.hpp"
 #include "kernels/position_sum.hpp"
+#include "kernels/weight_batch.hpp"
 #include "kernels/window.hpp"
 
 namespace mmpm {
@@ -40,14 +41,14 @@ struct ScatterSource {
 };
 
 // The per-particle factors of particle p (what WindowBlock::accumulate
-// scatters), for P2G and MUSL's momentum scatter in G2P, written into q in
-// place. With What = kMomentumOnly only m and mv are set (opt and inv_t are
-// not read); the other fields keep what they held. Why in place: the batch
-// loops that fill an array of sources (p2g_range_grouped, G2P's deferred
-// momentum scatter) built each one in a stack temporary and copied it with
-// 64-byte loads of a struct just written by 16-byte stores; every copy
-// waited on a failed store-to-load forward (~27 % of the 3D uGIMP batch
-// loop's samples, docs/performance.md "Scatter sources filled in place").
+// scatters), for P2G and MUSL's inline momentum scatter in G2P, written
+// into q in place. With What = kMomentumOnly only m and mv are set (opt and
+// inv_t are not read); the other fields keep what they held. The batch
+// loops (p2g_range_grouped, G2P's deferred momentum scatter) fill a
+// ScatterSourceBatch instead (below); filling an array of these structs
+// first went through stack temporaries, each copy waiting on a failed
+// store-to-load forward (docs/performance.md "Scatter sources filled in
+// place"), then stored every lane on its own.
 template <int D, class Real, unsigned What, bool Traction>
 [[gnu::always_inline]] inline void fill_scatter_source(ScatterSource<D, Real>& q,
                                                        const ParticleView<D, Real>& P,
@@ -79,6 +80,73 @@ template <int D, class Real, unsigned What, bool Traction>
   fill_scatter_source<D, Real, What, Traction>(q, P, opt, inv_t, p);
   return q;
 }
+
+// The factors of a batch of particles (at most kWeightBatch), field by
+// field: what the grouped scatter (GroupedScatter below) reads for each
+// particle of a run once per group. Why by field and not as an array of
+// ScatterSource: the fill loop, which GCC vectorises across particles,
+// then stores one vector per field and 8 particles, where filling structs
+// stored every lane on its own (13 scalar stores and their extracts per 3D
+// particle: most of the fill loop's ~13 % of the 3D uGIMP P2G samples,
+// docs/performance.md "Scatter sources stored by field"). Same products,
+// so the same bits. Fields a transfer does not scatter stay unwritten and
+// are never read.
+template <int D, class Real>
+struct ScatterSourceBatch {
+  static constexpr int NS = kStressComponents<D>;
+  Real mv[D][kWeightBatch], vs[NS][kWeightBatch], area[kWeightBatch], mw[D][kWeightBatch];
+  // The masses and traction forces are read in place (a copy loop became a
+  // call to memmove).
+  const Real* m = nullptr;
+  const Real* fe[D] = {};
+
+  // Entries 0 .. count - 1 from particles first .. first + count - 1, the
+  // products of fill_scatter_source.
+  template <unsigned What, bool Traction>
+  [[gnu::always_inline]] void fill(const ParticleView<D, Real>& P, const P2GOptions& opt,
+                                   Real inv_t, std::size_t first, std::size_t count) {
+    const Real* __restrict pm = P.m + first;
+    m = pm;
+    for (int d = 0; d < D; ++d) {
+      const Real* __restrict pv = P.v[d] + first;
+      for (std::size_t i = 0; i < count; ++i) mv[d][i] = pm[i] * pv[i];
+    }
+    if constexpr ((What & kForce) != 0) {
+      const Real* __restrict pV = P.V + first;
+      for (int c = 0; c < NS; ++c) {
+        const Real* __restrict ps = P.s[c] + first;
+        for (std::size_t i = 0; i < count; ++i) vs[c][i] = pV[i] * ps[i];
+      }
+      if constexpr (Traction)
+        for (int d = 0; d < D; ++d) fe[d] = P.fext[d] + first;
+    }
+    if constexpr ((What & kMultimaterial) != 0) {
+      for (std::size_t i = 0; i < count; ++i) area[i] = P.V[first + i] * (D == 2 ? inv_t : Real(1));
+      for (int d = 0; d < D; ++d)
+        for (std::size_t i = 0; i < count; ++i)
+          mw[d][i] = pm[i] * separation_coordinate(P, opt.position_separation, d, first + i);
+    }
+  }
+
+  // Entry k as the one-particle factors (only What's fields are read; the
+  // compiler keeps them as memory operands of the multiply-adds).
+  template <unsigned What, bool Traction>
+  [[gnu::always_inline]] ScatterSource<D, Real> at(std::size_t k) const {
+    ScatterSource<D, Real> q;
+    q.m = m[k];
+    for (int d = 0; d < D; ++d) q.mv[d] = mv[d][k];
+    if constexpr ((What & kForce) != 0) {
+      for (int c = 0; c < NS; ++c) q.vs[c] = vs[c][k];
+      if constexpr (Traction)
+        for (int d = 0; d < D; ++d) q.fe[d] = fe[d][k];
+    }
+    if constexpr ((What & kMultimaterial) != 0) {
+      q.area = area[k];
+      for (int d = 0; d < D; ++d) q.mw[d] = mw[d][k];
+    }
+    return q;
+  }
+};
 
 // Offset of particle p's field in the field-major grid arrays (0 with one field).
 template <bool MultiField, int D, class Real>
@@ -247,7 +315,7 @@ class GroupedScatter {
   // Windows w[0, count) in particle order, with their bases (field offset
   // included) and sources; `more`: particles follow, so a run reaching
   // count may go on in the next call.
-  void add(const Win* w, const std::size_t* base, const ScatterSource<D, Real>* q,
+  void add(const Win* w, const std::size_t* base, const ScatterSourceBatch<D, Real>& q,
            std::size_t count, bool more) {
     if (carrying_ && (count == 0 || base[0] != carried_[0].current)) finish();
     for (std::size_t i = 0; i < count;) {
@@ -260,7 +328,8 @@ class GroupedScatter {
         Block block;  // a local the compiler keeps in registers
         if (resume) block = carried_[g];
         block.current = base[i];
-        for (std::size_t k = i; k < j; ++k) block.template accumulate<g * UG>(w[k], q[k]);
+        for (std::size_t k = i; k < j; ++k)
+          block.template accumulate<g * UG>(w[k], q.template at<What, Traction>(k));
         if (cut)
           carried_[g] = block;
         else
