@@ -14,6 +14,7 @@ import argparse
 import datetime
 import json
 import os
+import re
 import subprocess
 import sys
 
@@ -784,9 +785,13 @@ def main():
     commit = context.get("git_commit") or git_commit(os.path.dirname(here))
     date = context.get("date") or datetime.datetime.now().isoformat(timespec="seconds")
     load_avg = context.get("load_avg")
+    # results-TAG.json: a host's own full run (bench/run --tag TAG).
+    tagged = re.fullmatch(r"results-(.+)\.json", os.path.basename(args.json))
+    full_run = f"bench/run --tag {tagged.group(1)}" if tagged else "bench/run"
     lines = ["# mmpm benchmark results", "",
              f"Tables written by `bench/table.py` from `bench/{os.path.basename(args.json)}`; reproduce with "
-             "`bench/run` (full, ~26 min) or `bench/run --quick` (subset, results on stdout). "
+             f"`{full_run}` (full, ~26 min on the 2096 MHz host, ~36 on the 2596 MHz one) or "
+             "`bench/run --quick` (subset, results on stdout). "
              "Only the notes at the end are hand-written.", "",
              f"- Date: {date}",
              f"- Machine: {model}, {cpus} CPU(s) (`lscpu`), {context.get('num_cpus', '?')} seen by "

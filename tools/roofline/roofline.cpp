@@ -24,12 +24,12 @@
 //    max(bytes / triad bandwidth, flops / peak). The "step" row counts the
 //    columns of the whole step once: how far the step is from streaming
 //    its particles once per step.
-// Usage: mmpm_roofline [--threads N] [--steps K] [--blocks B] [--only TEXT]
-//   --only runs the cases whose label contains TEXT (e.g. "2D linear").
+// Usage: kUsage below (mmpm_roofline --help).
 #include <omp.h>
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -176,20 +176,58 @@ double median(std::vector<double> v) {
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
+constexpr const char* kUsage =
+    "Usage: mmpm_roofline [--threads N] [--steps K] [--blocks B] [--only TEXT]\n"
+    "  --threads N  OpenMP threads (default 1)\n"
+    "  --steps K    steps per timed block (default 20)\n"
+    "  --blocks B   timed blocks per case and scheme (default 7)\n"
+    "  --only TEXT  only the cases whose label contains TEXT (e.g. \"2D linear\")\n"
+    "Runs ~3 minutes per thread count on a 2-core host; prints one table.\n";
+
+// The whole of s as an integer in [1, 10^6], into out.
+bool parse_count(const char* s, int& out) {
+  char* end = nullptr;
+  errno = 0;
+  const long v = std::strtol(s, &end, 10);
+  if (end == s || *end != '\0' || errno != 0 || v < 1 || v > 1000000) return false;
+  out = int(v);
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   int threads = 1, steps = 20, blocks = 7;
   const char* only = nullptr;
-  for (int i = 1; i + 1 < argc; ++i) {
-    if (!std::strcmp(argv[i], "--only")) only = argv[i + 1];
-    if (!std::strcmp(argv[i], "--threads")) threads = std::atoi(argv[i + 1]);
-    if (!std::strcmp(argv[i], "--steps")) steps = std::atoi(argv[i + 1]);
-    if (!std::strcmp(argv[i], "--blocks")) blocks = std::atoi(argv[i + 1]);
-  }
-  if (threads < 1 || steps < 1 || blocks < 1) {
-    std::fprintf(stderr, "mmpm_roofline: --threads, --steps and --blocks take integers >= 1\n");
-    return 2;
+  // Every argument checked before anything runs: a mistyped option must not
+  // start minutes of measurement (or be ignored).
+  for (int i = 1; i < argc; ++i) {
+    const char* arg = argv[i];
+    if (!std::strcmp(arg, "--help") || !std::strcmp(arg, "-h")) {
+      std::fputs(kUsage, stdout);
+      return 0;
+    }
+    const bool text = !std::strcmp(arg, "--only");
+    int* count = !std::strcmp(arg, "--threads")  ? &threads
+                 : !std::strcmp(arg, "--steps")  ? &steps
+                 : !std::strcmp(arg, "--blocks") ? &blocks
+                                                 : nullptr;
+    if (!text && !count) {
+      std::fprintf(stderr, "mmpm_roofline: unknown option '%s'\n%s", arg, kUsage);
+      return 2;
+    }
+    if (i + 1 >= argc) {
+      std::fprintf(stderr, "mmpm_roofline: %s expects a value\n%s", arg, kUsage);
+      return 2;
+    }
+    const char* value = argv[++i];
+    if (text) {
+      only = value;
+    } else if (!parse_count(value, *count)) {
+      std::fprintf(stderr, "mmpm_roofline: %s expects an integer from 1 to 1000000, got '%s'\n",
+                   arg, value);
+      return 2;
+    }
   }
   const Case cases[] = {{"2D linear double", 2, "linear", "double", 2},
                         {"2D gimp double", 2, "gimp", "double", 3},
