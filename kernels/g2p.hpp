@@ -339,16 +339,12 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
   std::conditional_t<kDefer, GroupedScatter<D, Shape, Real, kMomentumOnly, false, kDeferUG>,
                      NoDeferred>
       deferred(G);
-  // m and m v of particle p (the momentum pass has no force terms).
-  auto fill_momentum_source = [&](ScatterSource<D, Real> & s, std::size_t p)
-      __attribute__((always_inline)) {
-    fill_scatter_source<D, Real, kMomentumOnly, false>(s, P, P2GOptions{}, Real(1), p);
-  };
   auto scatter_momentum = [&](const Weights& w, std::size_t p, std::size_t fo)
       __attribute__((always_inline)) {
     if constexpr (kDefer) return;  // after the batch
-    ScatterSource<D, Real> s;
-    fill_momentum_source(s, p);
+    // m and m v of particle p (the momentum pass has no force terms).
+    const ScatterSource<D, Real> s =
+        scatter_source<D, Real, kMomentumOnly, false>(P, P2GOptions{}, Real(1), p);
     if constexpr (Windowed) {
       block.at(w.base + fo, G, off);
       block.accumulate(w, s);
