@@ -25,15 +25,56 @@ using Lanes = typename LanesOf<Real, W>::type;
 template <class V>
 using LaneReal = std::remove_cvref_t<decltype(std::declval<V>()[0])>;
 
+// Bytes of the widest vector register the target has.
+#if defined(__AVX512F__)
+inline constexpr std::size_t kRegisterVectorBytes = 64;
+#elif defined(__AVX__)
+inline constexpr std::size_t kRegisterVectorBytes = 32;
+#else
+inline constexpr std::size_t kRegisterVectorBytes = 16;
+#endif
+
+// Loads and stores of a vector wider than the target's registers (a row of
+// 4 doubles, 32 bytes, under SSE2) go register-sized half by half. Why: GCC
+// has no machine mode for such a vector, so a whole-vector memcpy went
+// through a stack copy (a row's read-modify-write: two 16-byte stores to
+// the stack and two loads back before the two stores to the grid; a
+// 64-byte vector under AVX2: 32-byte stores read back by 16-byte loads,
+// which the store buffer cannot forward; docs/performance.md "Targets
+// without AVX-512"). The halves are the same bytes, so the results are too.
 template <class V>
 inline V lanes_load(const void* p) {
-  V v;
-  std::memcpy(&v, p, sizeof(V));
-  return v;
+  if constexpr (sizeof(V) > kRegisterVectorBytes) {
+    using Real = LaneReal<V>;
+    constexpr int n = int(sizeof(V) / sizeof(Real));
+    using H = Lanes<Real, n / 2>;
+    const H lo = lanes_load<H>(p);
+    const H hi = lanes_load<H>(static_cast<const char*>(p) + sizeof(H));
+    return [&]<std::size_t... I>(std::index_sequence<I...>) {
+      return __builtin_shufflevector(lo, hi, int(I)...);
+    }
+    (std::make_index_sequence<std::size_t(n)>{});
+  } else {
+    V v;
+    std::memcpy(&v, p, sizeof(V));
+    return v;
+  }
 }
 template <class V>
 inline void lanes_store(void* p, const V& v) {
-  std::memcpy(p, &v, sizeof(V));
+  if constexpr (sizeof(V) > kRegisterVectorBytes) {
+    using Real = LaneReal<V>;
+    constexpr int n = int(sizeof(V) / sizeof(Real));
+    using H = Lanes<Real, n / 2>;
+    const auto half = [&]<std::size_t... I>(auto first, std::index_sequence<I...>) {
+      return __builtin_shufflevector(v, v, decltype(first)::value + int(I)...);
+    };
+    lanes_store(p, half(std::integral_constant<int, 0>{}, std::make_index_sequence<n / 2>{}));
+    lanes_store(static_cast<char*>(p) + sizeof(H),
+                half(std::integral_constant<int, n / 2>{}, std::make_index_sequence<n / 2>{}));
+  } else {
+    std::memcpy(p, &v, sizeof(V));
+  }
 }
 // Lanes 0, 1, ..., W-1.
 template <class V, int W>

@@ -12,9 +12,13 @@
 //  - the window is a fixed number of fixed-length vectors ("units"), so the
 //    transfers are vector multiply-adds where a 3-node stencil starting
 //    anywhere did not vectorise. A unit is RU consecutive rows of W nodes
-//    along x, as many as fill 64 bytes (one AVX-512 register; two AVX2
-//    registers elsewhere): 2D uGIMP in double = 2 units of 2 rows x 4
-//    nodes; 2D linear = the whole window (4 lanes), 3D linear = 8 lanes.
+//    along x, as many as fill one vector register (kRegisterVectorBytes:
+//    64 bytes with AVX-512, 32 with AVX2): with AVX-512, 2D uGIMP in
+//    double = 2 units of 2 rows x 4 nodes, 2D linear = the whole window (4
+//    lanes), 3D linear = 8 lanes; with AVX2, one row of 4 doubles per unit.
+//    A unit wider than the registers has no machine mode in GCC, which then
+//    moves it through the stack (docs/performance.md "Targets without
+//    AVX-512").
 // Window nodes outside the particle's reach get weight 0 (Shape::lanes()
 // evaluates every window node). Near the grid's edge the window is shifted
 // inward, so it never leaves the grid; a particle whose own stencil leaves
@@ -67,7 +71,7 @@ template <int N, class F>
   static_for_each(f, std::make_integer_sequence<int, N>{});
 }
 
-// Rows per unit: the most that fill at most `cap` (64 bytes' worth) and
+// Rows per unit: the most that fill at most `cap` (one register's worth) and
 // divide the rows evenly, as a power of two (vector lanes are).
 constexpr int window_rows_per_unit(int rows, int cap) {
   int ru = 1;
@@ -87,8 +91,9 @@ struct Window {
   static constexpr int WY = binned_by_nearest_node<D, Shape, Real> ? 3 : W;
   static constexpr int N = D == 2 ? W * WY : W * WY * WY;  // window nodes
   static constexpr int R = N / W;                          // rows of W nodes along x
-  static constexpr int RU = window_rows_per_unit(R, 64 / int(W * sizeof(Real)));  // rows per unit
-  static constexpr int L = W * RU;                                                // lanes per unit
+  static constexpr int RU =
+      window_rows_per_unit(R, int(kRegisterVectorBytes) / int(W * sizeof(Real)));  // rows per unit
+  static constexpr int L = W * RU;                                                 // lanes per unit
   static constexpr int units = R / RU;
   // All directions' 1D weights in one vector (lane d * W + k: direction d,
   // node k), so the shape function runs once per particle, not once per
@@ -255,11 +260,12 @@ struct WindowUnits {
   }
 };
 
-// Rows per unit of the scatters: the most that fill at most `cap` (64
-// bytes' worth), as a power of two, whether or not they divide the rows.
-// 3D uGIMP and quadratic B-splines in double (9 rows of 4 nodes): 5 units
-// of 2 rows, one AVX-512 register each, where Window has 9 of one row, half
-// a register (docs/performance.md "Two rows per unit in the 3D scatter").
+// Rows per unit of the scatters: the most that fill at most `cap` (one
+// register's worth), as a power of two, whether or not they divide the rows.
+// 3D uGIMP and quadratic B-splines in double (9 rows of 4 nodes), with
+// AVX-512: 5 units of 2 rows, one register each, where Window has 9 of one
+// row, half a register (docs/performance.md "Two rows per unit in the 3D
+// scatter"); with AVX2 both are one row.
 constexpr int scatter_rows_per_unit(int rows, int cap) {
   int ru = 1;
   while (2 * ru <= cap && 2 * ru <= rows) ru *= 2;
@@ -267,8 +273,9 @@ constexpr int scatter_rows_per_unit(int rows, int cap) {
 }
 template <int D, class Shape, class Real>
 using ScatterUnits =
-    WindowUnits<Window<D, Shape, Real>, scatter_rows_per_unit(Window<D, Shape, Real>::R,
-                                                              64 / int(Shape::W * sizeof(Real)))>;
+    WindowUnits<Window<D, Shape, Real>,
+                scatter_rows_per_unit(Window<D, Shape, Real>::R,
+                                      int(kRegisterVectorBytes) / int(Shape::W * sizeof(Real)))>;
 // Window's own units (one row per unit in the case above): the scatters'
 // baseline in the benchmarks and tests.
 template <int D, class Shape, class Real>
@@ -282,13 +289,15 @@ class WindowBuilder {
   using Win = Window<D, Shape, Real>;
   static constexpr int W = Win::W, DP = Win::DP;
   using VA = typename Win::VA;
-  // The shape function runs on parts of VA of at most one 64-byte register.
+  // The shape function runs on parts of VA of at most one register.
   // Why: GCC lowers the compares and selects of a vector wider than the
   // machine's (3D W = 4 in double: 16 lanes, two registers) lane by lane,
   // each lane through the stack; the uGIMP clamps then cost more than the
   // rest of the transfer (3D uGIMP double P2G 115 ns/particle vs 33 in
   // float, whose VA is one register).
-  static constexpr int kParts = sizeof(VA) > 64 ? int(sizeof(VA) / 64) : 1;
+  static constexpr int kParts = sizeof(VA) > kRegisterVectorBytes
+                                    ? int(sizeof(VA) / kRegisterVectorBytes)
+                                    : 1;
   static constexpr int PL = W * DP / kParts;  // lanes per part
   using Part = Lanes<Real, PL>;
 

@@ -266,11 +266,10 @@ struct WindowBlock {
 // AVX2 16, and the weights and factors of the particle need a few.
 #ifdef __AVX512F__
 inline constexpr int kVectorRegisters = 28;
-inline constexpr int kVectorBytes = 64;
 #else
 inline constexpr int kVectorRegisters = 12;
-inline constexpr int kVectorBytes = 32;
 #endif
+inline constexpr int kVectorBytes = int(kRegisterVectorBytes);
 // The same budget in vectors of type V (one of 64 bytes is two AVX2
 // registers; one of 32 bytes, a row of 4 doubles, is one register either way).
 template <class V>
