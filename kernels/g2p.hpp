@@ -71,7 +71,7 @@ struct G2PGather {
   // product and sum in one 512-bit vector (gather_pair). The one-particle
   // gather reads the lower half.
   static constexpr bool kPairs =
-      Pairs && Windowed && D == 3 && Win::L == 4 && sizeof(Real) == 8 && kVectorBytes == 64;
+      Pairs && Windowed && D == 3 && Win::L == 4 && sizeof(Real) == 8 && kRegisterVectorBytes == 64;
   using V2 = Lanes<Real, 8>;
   using HeldVec = std::conditional_t<kPairs, V2, typename Win::V>;
   struct WindowValues {

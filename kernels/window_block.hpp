@@ -269,13 +269,13 @@ inline constexpr int kVectorRegisters = 28;
 #else
 inline constexpr int kVectorRegisters = 12;
 #endif
-inline constexpr int kVectorBytes = int(kRegisterVectorBytes);
 // The same budget in vectors of type V (one of 64 bytes is two AVX2
 // registers; one of 32 bytes, a row of 4 doubles, is one register either way).
 template <class V>
 constexpr int block_register_budget() {
   constexpr int bytes = int(sizeof(V));
-  return kVectorRegisters / (bytes > kVectorBytes ? bytes / kVectorBytes : 1);
+  constexpr int reg = int(kRegisterVectorBytes);
+  return kVectorRegisters / (bytes > reg ? bytes / reg : 1);
 }
 
 // Units per block group: all of the scatter's units when their sums fit in
