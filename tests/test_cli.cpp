@@ -318,6 +318,17 @@ TEST(Cli, AbsurdModulusIsBadInputNotAHang) {
   }
 }
 
+// A body's velocity sets the step as well (dt = cfl h / (c + |v|)); when
+// it is what makes dt absurd, the message names the body, not a material.
+TEST(Cli, AbsurdVelocityIsBlamedOnTheBody) {
+  const CmdResult r = run_mmpm({"check", bar_scene(), "--set", "body[0].velocity=[1e30, 0.0]"});
+  EXPECT_EQ(r.exit_code, 2) << r.describe();
+  const auto lines = lines_of(r.err);
+  ASSERT_EQ(lines.size(), 1u) << r.describe();
+  EXPECT_TRUE(contains(lines[0], "the velocity of body 'bar'")) << lines[0];
+  EXPECT_FALSE(contains(lines[0], "modulus")) << lines[0];
+}
+
 // Grid damping is explicit, p <- p (1 - alpha dt) + dt f: unstable once
 // alpha dt > 2. The time step respects 2 / alpha as well as the wave speed
 // (the steel bar, h / c = 9.9e-5 ms, with alpha = 1e5 / ms: 2 / alpha =
@@ -361,6 +372,35 @@ TEST(Cli, RunEndsExactlyAtEndTime) {
   const auto time = f.root().open_group("series").open_dataset("time").read_doubles();
   ASSERT_FALSE(time.empty());
   EXPECT_EQ(time.back(), end);
+}
+
+// A snapshot interval far below dt writes one snapshot per step and ends:
+// the driver used to step its snapshot counter one `every` at a time,
+// (t + dt / 2) / every increments per snapshot (with every = 1e-9 ms and
+// the bar's dt ~4e-5 ms, ~4e4 per step growing to ~1e6; collision.toml
+// with every = 1e-12 did not end in a minute). An interval below
+// end_time * 1e-12 is bad input (the counter is a long).
+TEST(Cli, SnapshotIntervalBelowTheStepWritesEveryStep) {
+  TempDir tmp;
+  const fs::path out = tmp / "bar";
+  const CmdResult r = run_mmpm({"run", bar_scene(), "--set", "simulation.end_time=0.002", "--set",
+                                "output.every=1e-9", "--set", "output.fields=[\"velocity\"]",
+                                "--quiet", "--out", out.string()});
+  ASSERT_EQ(r.exit_code, 0) << r.describe();
+  const json j = json::parse(read_text(out / "summary.json"));
+  const long steps = j.at("steps").get<long>();
+  ASSERT_GT(steps, 10);
+  using namespace mmpm::io;
+  const h5::File f = h5::File::open(out / "run.h5", h5::File::Mode::read_only);
+  EXPECT_EQ(long(f.root().open_group("particles").children().size()), steps + 1)
+      << "the initial state and one snapshot per step";
+
+  const CmdResult bad = run_mmpm({"check", bar_scene(), "--set", "output.every=1e-20"});
+  EXPECT_EQ(bad.exit_code, 2) << bad.describe();
+  const auto lines = lines_of(bad.err);
+  ASSERT_EQ(lines.size(), 1u) << bad.describe();
+  EXPECT_TRUE(contains(lines[0], "output.every")) << lines[0];
+  EXPECT_TRUE(contains(lines[0], "end_time * 1e-12")) << lines[0];
 }
 
 // Sizes no run could allocate are refused before anything is allocated,

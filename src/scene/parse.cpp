@@ -1302,7 +1302,16 @@ class SceneReader {
   void read_output(const Table& t) {
     t.only({"every", "fields", "series", "checkpoint_minutes", "directory"});
     OutputSpec& o = scene_.output;
-    if (auto f = t.get("every")) o.every = f->non_negative();
+    if (auto f = t.get("every")) {
+      o.every = f->non_negative();
+      // The driver counts snapshot times k * every in a long; a ratio past
+      // 1e12 is a typo, not a request (a snapshot per step needs only
+      // every <= dt).
+      if (o.every > 0 && scene_.simulation.end_time / o.every > 1e12)
+        f->fail("expected 0 (the last state only) or at least end_time * 1e-12 = " +
+                format_number(scene_.simulation.end_time * 1e-12) + ", got " +
+                format_number(o.every) + " (every <= dt already writes every step)");
+    }
     if (auto f = t.get("fields")) {
       o.fields = output_fields(*f);
       // F is kept only for finite-strain materials (the H columns); said

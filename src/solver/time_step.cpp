@@ -11,18 +11,37 @@
 namespace mmpm {
 namespace {
 
-// The fastest dilatational wave among the materials, and whose it is.
-struct FastestWave {
+// The fastest dilatational wave among the materials, or the fastest
+// prescribed motion (a body's initial velocity, a rigid material's table),
+// and whose it is.
+struct Fastest {
   double speed = 0;
-  std::string material;
+  std::string who;
 };
-FastestWave fastest_wave(const Scene& scene) {
-  FastestWave f;
+Fastest fastest_wave(const Scene& scene) {
+  Fastest f;
   for (const auto& m : scene.materials) {
     const double c =
         make_material(m, scene.simulation.dimension, scene.simulation.plane).wave_speed;
-    if (c > f.speed) f.speed = c, f.material = m.name;
+    if (c > f.speed) f.speed = c, f.who = "the wave speed of material '" + m.name + "'";
   }
+  return f;
+}
+Fastest fastest_motion(const Scene& scene) {
+  const int dim = scene.simulation.dimension;
+  const auto norm = [dim](const auto& v) {
+    double v2 = 0;
+    for (int d = 0; d < dim; ++d) v2 += v[d] * v[d];
+    return std::sqrt(v2);
+  };
+  Fastest f;
+  for (const auto& b : scene.bodies)
+    if (const double v = norm(b.velocity); v > f.speed)
+      f.speed = v, f.who = "the velocity of body '" + b.name + "'";
+  for (const auto& m : scene.materials)
+    for (const auto& row : m.velocity.velocity)
+      if (const double v = norm(row); v > f.speed)
+        f.speed = v, f.who = "the velocity of rigid material '" + m.name + "'";
   return f;
 }
 
@@ -35,20 +54,7 @@ double critical_time_step(const Scene& scene) {
   const int dim = scene.simulation.dimension;
   double hmin = scene.grid.cell[0];
   for (int d = 1; d < dim; ++d) hmin = std::min(hmin, scene.grid.cell[d]);
-  const double c = fastest_wave(scene).speed;
-  double vmax = 0;
-  for (const auto& b : scene.bodies) {
-    double v2 = 0;
-    for (int d = 0; d < dim; ++d) v2 += b.velocity[d] * b.velocity[d];
-    vmax = std::max(vmax, std::sqrt(v2));
-  }
-  for (const auto& m : scene.materials)
-    for (const auto& v : m.velocity.velocity) {
-      double v2 = 0;
-      for (int d = 0; d < dim; ++d) v2 += v[d] * v[d];
-      vmax = std::max(vmax, std::sqrt(v2));
-    }
-  const double speed = c + vmax;
+  const double speed = fastest_wave(scene).speed + fastest_motion(scene).speed;
   const double wave = speed > 0 ? hmin / speed : scene.simulation.end_time;
   return std::min(wave, damping_time_step(scene));
 }
@@ -70,16 +76,18 @@ constexpr double kMaxSteps = 1e12;
 // end_time (huge moduli, tiny densities), named at the key that set it:
 // left alone, dt = 0 ran forever and `check` printed a negative step count.
 [[noreturn]] void bad_time_step(const Scene& scene, double dt, double steps) {
-  const FastestWave fastest = fastest_wave(scene);
+  const Fastest wave = fastest_wave(scene), motion = fastest_motion(scene);
+  const Fastest& fastest = motion.speed > wave.speed ? motion : wave;
   std::ostringstream msg;
   msg << "the time step is " << dt;
   if (dt > 0 && std::isfinite(dt))
     msg << ", so end_time / dt = " << steps << " steps; expected at most " << kMaxSteps;
   else
     msg << "; expected a positive time step";
-  if (!fastest.material.empty())
-    msg << " (the fastest wave speed, of material '" << fastest.material << "', is "
-        << fastest.speed << "; check its modulus and density)";
+  if (!fastest.who.empty())
+    msg << " (the step follows the fastest speed, " << fastest.who << ", " << fastest.speed
+        << "; check "
+        << (&fastest == &motion ? "that velocity" : "that material's modulus and density") << ")";
   fail_at_time_step_key(scene, msg.str());
 }
 
