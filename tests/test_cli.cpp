@@ -458,6 +458,29 @@ TEST(Cli, CommandLineMistakesGetOneClearMessage) {
   EXPECT_FALSE(fs::exists(tmp / "s" / "sweep.csv"));
 }
 
+// An output directory that cannot be made or written is bad input, said
+// before the first step: a path under a regular file, and /proc, which
+// refuses even root (it used to end with a filesystem_error, exit 3).
+TEST(Cli, UnwritableOutputDirectoryIsBadInput) {
+  TempDir tmp;
+  write_text(tmp / "plain_file", "x");
+  const std::vector<std::string> dirs{(tmp / "plain_file" / "o").string(),
+                                      (tmp / "plain_file").string(), "/proc/mmpm_out"};
+  for (const std::string& out : dirs) {
+    for (const char* sub : {"run", "sweep"}) {
+      std::vector<std::string> args{sub, bar_scene(), "--out", out, "--quiet"};
+      if (std::string(sub) == "sweep")
+        args.insert(args.end(), {"--param", "simulation.end_time", "--values", "0.001"});
+      const CmdResult r = run_mmpm(args);
+      EXPECT_EQ(r.exit_code, 2) << sub << " " << out << "\n" << r.describe();
+      const auto lines = lines_of(r.err);
+      ASSERT_EQ(lines.size(), 1u) << r.describe();
+      EXPECT_TRUE(contains(lines[0], "--out " + out + ": cannot write the output directory"))
+          << lines[0];
+    }
+  }
+}
+
 // CSV fields of one line (RFC 4180 quotes).
 std::vector<std::string> csv_fields(const std::string& line) {
   std::vector<std::string> out(1);

@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "app/build_info.hpp"
+#include "app/output_directory.hpp"
 #include "app/timing_table.hpp"
 #include "io/atomic_file.hpp"
 #include "io/checkpoint.hpp"
@@ -207,7 +208,9 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
 
   // Every requested output field must exist before anything is written.
   (void)sim->snapshot(scene.output.fields);
-  fs::create_directories(dir);
+  prepare_output_directory(dir, resume            ? "--restart"
+                                : opt.out.empty() ? "output.directory"
+                                                  : "--out");
   std::unique_ptr<io::RunWriter> writer;
   if (resume) {
     sim->load_state(*resume);

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <thread>
 
+#include "app/output_directory.hpp"
 #include "app/run_driver.hpp"
 #include "io/atomic_file.hpp"
 #include "scene/error.hpp"
@@ -57,7 +58,7 @@ int run_sweep(const SweepOptions& opt) {
   }
   const fs::path dir =
       opt.out.empty() ? fs::path("results") / (scenes.front().name + "_sweep") : opt.out;
-  fs::create_directories(dir);
+  prepare_output_directory(dir, opt.out.empty() ? "sweep directory" : "--out");
   const int jobs = std::max(1, std::min<int>(opt.jobs, int(n)));
   const int cores = int(std::max(1u, std::thread::hardware_concurrency()));
   const int threads = opt.threads > 0 ? opt.threads : std::max(1, cores / jobs);
