@@ -23,10 +23,10 @@ class SimulationError : public std::runtime_error {
 };
 
 struct Energies {
-  double kinetic = 0;             // particles: sum m v^2 / 2
+  double kinetic = 0;             // deformable particles: sum m v^2 / 2
   double strain = 0;              // state function of the stresses / F
   double interface = 0;           // sum over multimaterial nodes (ALGORITHM §3.2)
-  double external_work = 0;       // tractions, gravity, moving supports
+  double external_work = 0;       // tractions, gravity, moving supports, rigid materials
   double damping = 0;             // removed by grid damping
   double kinetic_unresolved = 0;  // particle KE minus the KE of the grid velocity field
 };

@@ -156,6 +156,7 @@ class Stepper final : public Simulation {
   void update_active_nodes();
   void finish_velocities(bool with_dvel);
   Supports<Real> supports(bool with_dvel);
+  void add_rigid_work();
   void collect_support_reactions();
   void update_tractions();
   [[noreturn]] void fail_particle(const char* stage, std::size_t p, const std::string& why) const;

@@ -343,14 +343,16 @@ double Stepper<D, Shape, Real>::grid_kinetic_energy() const {
   const FieldNodeRuns* active = own_.active;
   return deterministic_sum<1>(
       total, [&](std::size_t b, std::size_t end, std::array<double, 1>& acc) {
-        if (!active) return sum(b, end, acc);
-        // A chunk's runs in node order: the nodes
-        // skipped hold m = 0 and would add +0.
+        // Field by field, rigid fields left out (as in energies()); with
+        // `active`, a field's runs in node order: the nodes skipped hold
+        // m = 0 and would add +0.
         for (std::size_t i = b; i < end;) {
           const std::size_t f = i / G_.nodes, o = f * G_.nodes;
           const std::size_t last = std::min(end, o + G_.nodes);
-          active->for_each(int(f), i - o, last - o,
-                           [&](std::size_t r0, std::size_t r1) { sum(o + r0, o + r1, acc); });
+          if (!plan_.rigid[f] && !active) sum(i, last, acc);
+          if (!plan_.rigid[f] && active)
+            active->for_each(int(f), i - o, last - o,
+                             [&](std::size_t r0, std::size_t r1) { sum(o + r0, o + r1, acc); });
           i = last;
         }
       })[0];
@@ -736,6 +738,19 @@ void Stepper<D, Shape, Real>::collect_support_reactions() {
   }
 }
 
+// A rigid material does work on the bodies like a moving support: the force
+// it exerts on them (minus the reaction the bodies exert on it, ALGORITHM §7)
+// times the velocity it moved at this step.
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::add_rigid_work() {
+  for (int f = 0; f < plan_.fields; ++f) {
+    if (plan_.rigid_material[std::size_t(f)] < 0) continue;
+    const Vec3 r = mm_.rigid_reaction(f);
+    for (int d = 0; d < D; ++d)
+      external_work_ -= r[d] * rigid_velocity_now_[std::size_t(f) * 3 + std::size_t(d)] * dt_;
+  }
+}
+
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::finish_velocities(bool with_dvel) {
   const Supports<Real> s = supports(with_dvel);
@@ -854,6 +869,7 @@ void Stepper<D, Shape, Real>::step() {
   if (mm) {
     tic();
     mm_.pass_b(G_, own_);
+    add_rigid_work();
     toc(kStageMultimaterial);
   }
   if (mm) {  // else grid_update_stage set the velocities
@@ -940,11 +956,14 @@ Energies Stepper<D, Shape, Real>::energies() const {
   auto parts =
       deterministic_sum<2>(n, [&](std::size_t b, std::size_t end, std::array<double, 2>& acc) {
         for (std::size_t p = b; p < end; ++p) {
+          // A rigid material's motion is prescribed, not part of the
+          // system's energy: its work on the bodies is external work
+          // (add_rigid_work), and its nominal mass carries no kinetic energy.
+          const MaterialModel& mat = materials_[P_.mat[p]];
+          if (mat.rigid()) continue;
           double v2 = 0;
           for (int d = 0; d < D; ++d) v2 += double(P_.v[d][p]) * double(P_.v[d][p]);
           acc[0] += 0.5 * double(P_.m[p]) * v2;
-          const MaterialModel& mat = materials_[P_.mat[p]];
-          if (mat.rigid()) continue;
           if (mat.finite_strain()) {
             double F[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
             for (int i = 0; i < D; ++i)
