@@ -481,6 +481,39 @@ TEST(Cli, UnwritableOutputDirectoryIsBadInput) {
   }
 }
 
+// Contact with separation = "displacement" assumes bodies that touch at the
+// start (ALGORITHM §3); `check` and `run` warn when a contact pair starts
+// apart (solver/contact_gap.hpp). collision.toml's blocks (h = 0.5 mm,
+// 2 x 2 ppc: spacing 0.25, "touching" up to 1.5 spacings = 0.375 mm),
+// switched to the displacement method: 0.5 mm apart (the second block
+// from x = 12.25: nearest particles 11.875 and 12.375) warns and names the
+// interaction's line; from x = 12.0 (nearest 0.25 mm) it does not; the
+// shipped scenes (position method, or bodies that touch) do not.
+TEST(Cli, ContactPairsThatStartApartWarnWithDisplacementSeparation) {
+  const std::string collision = source_dir() + "/inputs/collision.toml";
+  const std::string disp = "interaction[0].separation=\"displacement\"";
+  const CmdResult apart =
+      run_mmpm({"check", collision, "--set", disp, "--set", "body[1].min=[12.25, 2.0]"});
+  ASSERT_EQ(apart.exit_code, 0) << apart.describe();
+  const auto lines = lines_of(apart.err);
+  ASSERT_EQ(lines.size(), 1u) << apart.describe();
+  const std::string where =
+      collision + ":" + std::to_string(line_of(read_text(collision), "[[interaction]]")) + ":";
+  EXPECT_TRUE(contains(lines[0], where + " warning: key 'interaction[0].separation'")) << lines[0];
+  EXPECT_TRUE(contains(lines[0], "nearest particles are 0.5 apart")) << lines[0];
+  EXPECT_TRUE(contains(lines[0], "at most 0.375")) << lines[0];
+
+  const CmdResult touching =
+      run_mmpm({"check", collision, "--set", disp, "--set", "body[1].min=[12.0, 2.0]"});
+  EXPECT_EQ(touching.exit_code, 0) << touching.describe();
+  EXPECT_EQ(touching.err, "") << touching.describe();
+  for (const char* scene : {"collision.toml", "incline_block.toml", "incline_disk.toml",
+                            "sphere_in_cube.toml", "two_layer.toml"}) {
+    const CmdResult r = run_mmpm({"check", source_dir() + "/inputs/" + scene});
+    EXPECT_EQ(r.err, "") << scene << "\n" << r.describe();
+  }
+}
+
 // CSV fields of one line (RFC 4180 quotes).
 std::vector<std::string> csv_fields(const std::string& line) {
   std::vector<std::string> out(1);

@@ -9,6 +9,7 @@
 #include "scene/error.hpp"
 #include "scene/format.hpp"
 #include "scene/parse.hpp"
+#include "solver/contact_gap.hpp"
 #include "solver/simulation.hpp"
 
 namespace {
@@ -30,6 +31,8 @@ int check_scene(const std::string& file, const std::vector<std::string>& sets) {
     std::cerr
         << file << ": warning: key 'simulation." << (scene.simulation.dt ? "dt" : "cfl")
         << "': the time step exceeds the stability limit; `mmpm run` refuses it unless --force\n";
+  for (const OpenContact& c : open_contacts(scene, *sim))
+    std::cerr << open_contact_warning(scene, c) << "\n";
   return 0;
 }
 

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <iostream>
 #include <ostream>
 #include <sstream>
 
@@ -20,6 +21,7 @@
 #include "io/summary.hpp"
 #include "scene/error.hpp"
 #include "scene/parse.hpp"
+#include "solver/contact_gap.hpp"
 #include "solver/simulation.hpp"
 
 namespace mmpm {
@@ -202,6 +204,9 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
   }
   check_step_count(scene, dt);
   std::unique_ptr<Simulation> sim = make_simulation(scene);
+  if (!resume && opt.warnings)
+    for (const OpenContact& c : open_contacts(scene, *sim))
+      std::cerr << open_contact_warning(scene, c) << "\n";
   const int dim = scene.simulation.dimension;
   DriverState st;
   st.names = series_names(*sim);

@@ -71,6 +71,7 @@ int run_sweep(const SweepOptions& opt) {
       ro.threads = threads;
       ro.quiet = true;
       ro.progress = false;
+      ro.warnings = k == 0;  // the scene's warnings once, not once per value
       std::ostringstream log;
       try {
         results[k] = run_scene(scenes[k], ro, log);

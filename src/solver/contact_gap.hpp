@@ -1,0 +1,37 @@
+// Contact pairs that start apart while their interaction uses the
+// displacement separation (ALGORITHM §3: "requires the bodies to touch in
+// the initial state"). With it, δ_n is the difference of displacements,
+// 0 at the start whatever the gap, so two approaching materials count as in
+// contact as soon as their particles reach a common node: a cell or more
+// before their surfaces meet. A rigid punch seeded 0.05 mm above a block
+// (0.1 mm cells) pushed it from the first step. Said as a warning by
+// `check` and `run`, since a scene may mean it.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "scene/scene.hpp"
+
+namespace mmpm {
+
+class Simulation;
+
+struct OpenContact {
+  std::size_t interaction = 0;  // index into scene.interactions
+  double nearest = 0;           // closest particles of the two materials (inf: none near)
+  double touching = 0;          // the largest distance that counts as touching
+};
+
+// The contact interactions (stick, frictionless, friction) with
+// separation = "displacement" whose two materials have no pair of
+// particles closer than 1.5 mean particle spacings (spacing: cell /
+// particles_per_cell, the largest over directions and over the material's
+// bodies) in the simulation's current (initial) state.
+std::vector<OpenContact> open_contacts(const Scene& scene, const Simulation& sim);
+
+// "FILE:LINE: warning: key 'interaction[i].separation': ..." for one entry.
+std::string open_contact_warning(const Scene& scene, const OpenContact& c);
+
+}  // namespace mmpm
