@@ -514,6 +514,29 @@ TEST(Cli, ContactPairsThatStartApartWarnWithDisplacementSeparation) {
   }
 }
 
+// The kinetic-ratio stop waits until the scene no longer drives the bodies
+// (run_driver.cpp still_driven): inputs/gripped_bar.toml, whose rigid grip
+// pulls the bar until 0.1 ms. With kinetic_ratio = 0.1, a threshold the
+// slow pull itself stays below (K / U ~ 1e-2 while loading), the run
+// stopped at 0.04 ms with 11 % of the final strain energy when the guard
+// was switched off; it must stop after 0.1 ms (measured 0.106), by the
+// ratio, with the bar at its full strain energy E A d^2 / (2L) =
+// 1.25e-3 mJ (1 %).
+TEST(Cli, KineticRatioStopWaitsForTheDriveToEnd) {
+  TempDir tmp;
+  const fs::path out = tmp / "grip";
+  const CmdResult r =
+      run_mmpm({"run", source_dir() + "/inputs/gripped_bar.toml", "--set", "stop.kinetic_ratio=0.1",
+                "--set", "stop.hold_steps=20", "--quiet", "--out", out.string()});
+  ASSERT_EQ(r.exit_code, 0) << r.describe();
+  const json j = json::parse(read_text(out / "summary.json"));
+  EXPECT_EQ(j.at("stopped_by"), "kinetic_ratio");
+  const double t = j.at("steps").get<double>() * j.at("dt").get<double>();
+  EXPECT_GT(t, 0.1) << "stopped while the grip still moved";
+  EXPECT_LT(t, 0.3);
+  EXPECT_NEAR(number(j.at("energy"), "strain") / 1.25e-3, 1.0, 0.01);
+}
+
 // CSV fields of one line (RFC 4180 quotes).
 std::vector<std::string> csv_fields(const std::string& line) {
   std::vector<std::string> out(1);

@@ -542,7 +542,8 @@ TEST(ValidationContact, DiskSpinUpFollowsTheContactOffset) {
   EXPECT_GT(sink[1], sink[0] + 0.1) << "a later contact lets the disk sink deeper";
 }
 
-// §9 A rigid grip's work (docs/contact_validation.md §9). A bar (E 1000
+// §9 A rigid grip's work (docs/contact_validation.md §9,
+// inputs/gripped_bar.toml). A bar (E 1000
 // MPa, nu 0, plane stress, 10 x 1 mm, h = 0.5 mm, 2 x 2 ppc, uGIMP) bonded
 // to two rigid grips by perfect interfaces (the contact laws, "stick"
 // included, act only while the materials approach, so they cannot pull):
@@ -557,68 +558,9 @@ TEST(ValidationContact, DiskSpinUpFollowsTheContactOffset) {
 // distance between the grips, to 1 % (measured 8e-6). With the grip far
 // from the bar the same table moves it without work or kinetic energy: a
 // prescribed motion is not part of the system's energy.
-const char* kGrippedBar = R"(
-[simulation]
-dimension = 2
-plane = "stress"
-end_time = 0.3
-cfl = 0.5
-flip = 0.99
-[grid]
-origin = [-3.0, -1.0]
-cell = [0.5, 0.5]
-cells = [36, 6]
-shape = "gimp"
-damping = 200.0
-[[material]]
-name = "bar"
-type = "isotropic"
-density = 1.0e-3
-E = 1000.0
-nu = 0.0
-[[material]]
-name = "fixed_grip"
-type = "rigid"
-density = 1.0e-3
-velocity = [0.0, 0.0]
-[[material]]
-name = "pulling_grip"
-type = "rigid"
-density = 1.0e-3
-velocity = { time = [0.0, 0.05, 0.1], velocity = [[0.0, 0.0], [0.1, 0.0], [0.0, 0.0]] }
-[[body]]
-material = "bar"
-shape = "box"
-min = [0.0, 0.0]
-max = [10.0, 1.0]
-[[body]]
-material = "fixed_grip"
-shape = "box"
-min = [-1.0, 0.0]
-max = [0.0, 1.0]
-[[body]]
-material = "pulling_grip"
-shape = "box"
-min = [10.0, 0.0]
-max = [11.0, 1.0]
-[[interaction]]
-materials = ["bar", "fixed_grip"]
-law = "interface"
-Dn = "perfect"
-Dt = "perfect"
-normal = "specified"
-normal_vector = [-1.0, 0.0]
-[[interaction]]
-materials = ["bar", "pulling_grip"]
-law = "interface"
-Dn = "perfect"
-Dt = "perfect"
-normal = "specified"
-normal_vector = [1.0, 0.0]
-)";
 
 TEST(ValidationContact, RigidGripWorkIsExternalWork) {
-  auto sim = testing::make_from_text(kGrippedBar);
+  auto sim = make_simulation(parse_scene_file(input("gripped_bar.toml")));
   testing::run_until(*sim, 0.3);
   const Energies e = sim->energies();
   const double exact = 1000.0 * 1.0 * 0.005 * 0.005 / (2.0 * 10.0);
@@ -631,8 +573,8 @@ TEST(ValidationContact, RigidGripWorkIsExternalWork) {
   EXPECT_LT(std::abs(balance), 0.01 * e.external_work);
   EXPECT_LT(e.kinetic, 1e-3 * e.strain) << "settled";
 
-  auto apart =
-      testing::make_from_text(kGrippedBar, {"body[2].min=[13.0, 0.0]", "body[2].max=[14.0, 1.0]"});
+  auto apart = make_simulation(parse_scene_file(
+      input("gripped_bar.toml"), {"body[2].min=[13.0, 0.0]", "body[2].max=[14.0, 1.0]"}));
   testing::run_until(*apart, 0.07);
   const Energies f = apart->energies();
   EXPECT_EQ(f.kinetic, 0.0);

@@ -183,6 +183,29 @@ class Progress {
   double first_frac_ = 0;
 };
 
+// True while the scene still drives the bodies at time t or later: a load
+// or a support's displacement still ramping, or a rigid material moving now
+// or at a later row of its table. The kinetic-ratio stop waits for the end
+// of the drive: a slow ramp or punch keeps kinetic / stored energy small
+// while it still loads. (Until 2026-11-27 a moving rigid material's
+// particles counted in the kinetic energy, which kept the ratio up.)
+bool still_driven(const Scene& scene, double t) {
+  for (const auto& l : scene.loads)
+    if (t < l.ramp) return true;
+  for (const auto& b : scene.boundaries)
+    if (b.has_displacement && t < b.ramp) return true;
+  for (const auto& m : scene.materials) {
+    if (m.type != MaterialType::rigid) continue;
+    const auto& table = m.velocity;
+    for (std::size_t k = 0; k < table.velocity.size(); ++k) {
+      const bool now_or_later = k + 1 >= table.time.size() || table.time[k + 1] > t;
+      const Vec3& v = table.velocity[k];
+      if (now_or_later && (v[0] != 0 || v[1] != 0 || v[2] != 0)) return true;
+    }
+  }
+  return false;
+}
+
 RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, const fs::path& dir,
                  const std::vector<io::Blob>* resume) {
   RunOutcome out;
@@ -295,7 +318,7 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
         const Energies e = sim->energies();
         const double stored = e.strain + e.interface;
         const double ratio = stored > 0 ? e.kinetic / stored : INFINITY;
-        if (ratio < scene.stop.kinetic_ratio) {
+        if (ratio < scene.stop.kinetic_ratio && !still_driven(scene, sim->time())) {
           if (st.streak_start < 0) st.streak_start = s;
           if (s - st.streak_start >= scene.stop.hold_steps) stop = true;
         } else {
