@@ -138,7 +138,13 @@ std::vector<OpenContact> open_contacts(const Scene& scene, const Simulation& sim
     Binned a = bin(g, x, mat, ma), b = bin(g, x, mat, mb);
     if (a.empty() || b.empty()) continue;
     if (a.size() > b.size()) std::swap(a, b);  // walk the cells of the smaller set
-    const double nearest = nearest_pair(g, x, a, b, reach, touching);
+    double nearest = nearest_pair(g, x, a, b, reach, touching);
+    // The search sees every pair up to `reach` cells apart; a larger
+    // distance found is not known to be the nearest.
+    double seen = std::numeric_limits<double>::infinity();
+    for (int d = 0; d < g.dim; ++d)
+      seen = std::min(seen, double(reach[std::size_t(d)]) * g.h[std::size_t(d)]);
+    if (nearest > seen * (1 + 1e-9)) nearest = std::numeric_limits<double>::infinity();
     if (nearest > touching) out.push_back({i, nearest, touching});
   }
   return out;
