@@ -174,8 +174,7 @@ ParticleSeeds make_particles(const Scene& scene) {
   std::vector<char> alive;
   std::vector<int> material_index(scene.bodies.size(), -1);
   for (std::size_t b = 0; b < scene.bodies.size(); ++b)
-    for (std::size_t m = 0; m < scene.materials.size(); ++m)
-      if (scene.materials[m].name == scene.bodies[b].material) material_index[b] = int(m);
+    material_index[b] = scene.material_index(scene.bodies[b].material);
 
   SeedCells cells(g, dim, scene.bodies.size() > 1);
   for (std::size_t bi = 0; bi < scene.bodies.size(); ++bi) {

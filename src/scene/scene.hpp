@@ -201,6 +201,13 @@ struct Scene {
   std::vector<LoadSpec> loads;
   OutputSpec output;
   StopSpec stop;
+
+  // Index into `materials` of the material called `material_name`, or -1.
+  int material_index(const std::string& material_name) const {
+    for (std::size_t m = 0; m < materials.size(); ++m)
+      if (materials[m].name == material_name) return int(m);
+    return -1;
+  }
 };
 
 }  // namespace mmpm

@@ -13,14 +13,14 @@
 namespace mmpm {
 namespace {
 
+struct OpenContact {
+  std::size_t interaction = 0;  // index into scene.interactions
+  double nearest = 0;           // closest particles of the two materials (inf: none near)
+  double touching = 0;          // the largest distance that counts as touching
+};
+
 bool is_contact_law(Law law) {
   return law == Law::stick || law == Law::frictionless || law == Law::friction;
-}
-
-int material_index(const Scene& scene, const std::string& name) {
-  for (std::size_t m = 0; m < scene.materials.size(); ++m)
-    if (scene.materials[m].name == name) return int(m);
-  return -1;
 }
 
 // The particle spacing of a material's bodies, the largest over directions
@@ -105,8 +105,6 @@ double nearest_pair(const CellGrid& g, const std::vector<double>& x, const Binne
   return best;
 }
 
-}  // namespace
-
 std::vector<OpenContact> open_contacts(const Scene& scene, const Simulation& sim) {
   std::vector<OpenContact> out;
   std::vector<std::size_t> checked;
@@ -127,8 +125,8 @@ std::vector<OpenContact> open_contacts(const Scene& scene, const Simulation& sim
   const std::vector<double> mat = sim.particle_field("material").values;
   for (const std::size_t i : checked) {
     const InteractionSpec& it = scene.interactions[i];
-    const int ma = material_index(scene, it.materials[0]);
-    const int mb = material_index(scene, it.materials[1]);
+    const int ma = scene.material_index(it.materials[0]);
+    const int mb = scene.material_index(it.materials[1]);
     const double sa = spacing_of(scene, it.materials[0]), sb = spacing_of(scene, it.materials[1]);
     if (ma < 0 || mb < 0 || sa == 0 || sb == 0) continue;  // a material without particles
     const double touching = 0.75 * (sa + sb);
@@ -168,6 +166,15 @@ std::string open_contact_warning(const Scene& scene, const OpenContact& c) {
        "particles share grid nodes, a cell or more before their surfaces meet; separation = "
        "\"position\" is meant for bodies that start apart";
   return m.str();
+}
+
+}  // namespace
+
+std::vector<std::string> open_contact_warnings(const Scene& scene, const Simulation& sim) {
+  std::vector<std::string> out;
+  for (const OpenContact& c : open_contacts(scene, sim))
+    out.push_back(open_contact_warning(scene, c));
+  return out;
 }
 
 }  // namespace mmpm

@@ -8,7 +8,6 @@
 // `check` and `run`, since a scene may mean it.
 #pragma once
 
-#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -18,20 +17,12 @@ namespace mmpm {
 
 class Simulation;
 
-struct OpenContact {
-  std::size_t interaction = 0;  // index into scene.interactions
-  double nearest = 0;           // closest particles of the two materials (inf: none near)
-  double touching = 0;          // the largest distance that counts as touching
-};
-
-// The contact interactions (stick, frictionless, friction) with
-// separation = "displacement" whose two materials have no pair of
-// particles closer than 1.5 mean particle spacings (spacing: cell /
+// One warning per contact interaction (stick, frictionless, friction) with
+// separation = "displacement" whose two materials have no pair of particles
+// closer than 1.5 mean particle spacings (spacing: cell /
 // particles_per_cell, the largest over directions and over the material's
-// bodies) in the simulation's current (initial) state.
-std::vector<OpenContact> open_contacts(const Scene& scene, const Simulation& sim);
-
-// "FILE:LINE: warning: key 'interaction[i].separation': ..." for one entry.
-std::string open_contact_warning(const Scene& scene, const OpenContact& c);
+// bodies) in the simulation's current (initial) state:
+// "FILE:LINE: warning: key 'interaction[i].separation': ...".
+std::vector<std::string> open_contact_warnings(const Scene& scene, const Simulation& sim);
 
 }  // namespace mmpm

@@ -10,14 +10,9 @@ FieldPlan plan_fields(const Scene& scene) {
   FieldPlan plan;
   const std::size_t nm = scene.materials.size();
   std::vector<bool> named(nm, false);
-  auto index_of = [&](const std::string& name) {
-    for (std::size_t m = 0; m < nm; ++m)
-      if (scene.materials[m].name == name) return int(m);
-    return -1;
-  };
   for (const auto& it : scene.interactions)
     for (const auto& n : it.materials) {
-      const int m = index_of(n);
+      const int m = scene.material_index(n);
       if (m >= 0) named[std::size_t(m)] = true;
     }
   for (std::size_t m = 0; m < nm; ++m)
@@ -61,8 +56,8 @@ FieldPlan plan_fields(const Scene& scene) {
     any = true;
   }
   for (const auto& it : scene.interactions) {
-    const int a = plan.field_of_material[std::size_t(index_of(it.materials[0]))];
-    const int b = plan.field_of_material[std::size_t(index_of(it.materials[1]))];
+    const int a = plan.field_of_material[std::size_t(scene.material_index(it.materials[0]))];
+    const int b = plan.field_of_material[std::size_t(scene.material_index(it.materials[1]))];
     const int law = int(plan.laws.size());
     plan.laws.push_back(it);
     plan.pair[std::size_t(a) * F + std::size_t(b)] = law;
