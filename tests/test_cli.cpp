@@ -514,6 +514,66 @@ TEST(Cli, ContactPairsThatStartApartWarnWithDisplacementSeparation) {
   }
 }
 
+// Pairs without an [[interaction]] of their own fall back on [simulation]
+// default_law (stick unless set): the same check applies to them. A third
+// material, named in no interaction, lies 1 mm above both blocks of
+// collision.toml (nearest particles 1.25 apart; spacing 0.25, so at most
+// 0.375 counts as touching): two warnings, one per pair, naming the default
+// law; none once default_law = "separate"; one (the pair with block b) when
+// the third body touches block a.
+TEST(Cli, DefaultLawPairsThatStartApartWarnToo) {
+  TempDir tmp;
+  const fs::path scene = tmp / "three.toml";
+  std::string text = read_text(source_dir() + "/inputs/collision.toml");
+  const std::string third = R"([[material]]
+name    = "strip"
+type    = "isotropic"
+density = 1.0e-3
+E       = 100.0
+nu      = 0.0
+
+[[body]]
+name     = "c"
+material = "strip"
+shape    = "box"
+min      = [2.0, 7.0]
+max      = [22.5, 7.5]
+particles_per_cell = 2
+
+)";
+  text.insert(text.find("[[interaction]]"), third);
+  write_text(scene, text);
+  const std::string disp = "interaction[0].separation=\"displacement\"";
+  const std::string touch_ab = "body[1].min=[12.0, 2.0]";
+  const CmdResult apart = run_mmpm({"check", scene.string(), "--set", disp, "--set", touch_ab});
+  ASSERT_EQ(apart.exit_code, 0) << apart.describe();
+  const auto lines = lines_of(apart.err);
+  ASSERT_EQ(lines.size(), 2u) << apart.describe();
+  for (const std::string& line : lines) {
+    EXPECT_TRUE(contains(line, scene.string() + ": warning: key 'simulation.default_law' (stick"))
+        << line;
+    // The search looks one cell (0.5) around each particle: beyond that,
+    // "more than" the threshold.
+    EXPECT_TRUE(contains(line, "nearest particles are more than 0.375 apart")) << line;
+    EXPECT_TRUE(contains(line, "'strip'")) << line;
+  }
+  EXPECT_NE(contains(lines[0], "'block_a'"), contains(lines[1], "'block_a'")) << apart.err;
+  EXPECT_NE(contains(lines[0], "'block_b'"), contains(lines[1], "'block_b'")) << apart.err;
+
+  const CmdResult separate = run_mmpm({"check", scene.string(), "--set", disp, "--set", touch_ab,
+                                       "--set", "simulation.default_law=\"separate\""});
+  EXPECT_EQ(separate.exit_code, 0) << separate.describe();
+  EXPECT_EQ(separate.err, "") << separate.describe();
+
+  const CmdResult one = run_mmpm({"check", scene.string(), "--set", disp, "--set", touch_ab,
+                                  "--set", "body[2].max=[10.0, 7.5]", "--set",
+                                  "body[2].min=[2.0, 6.0]"});
+  EXPECT_EQ(one.exit_code, 0) << one.describe();
+  const auto one_lines = lines_of(one.err);
+  ASSERT_EQ(one_lines.size(), 1u) << one.describe();
+  EXPECT_TRUE(contains(one_lines[0], "'strip' and 'block_b'")) << one_lines[0];
+}
+
 // The kinetic-ratio stop waits until the scene no longer drives the bodies
 // (run_driver.cpp still_driven): inputs/gripped_bar.toml, whose rigid grip
 // pulls the bar until 0.1 ms. With kinetic_ratio = 0.1, a threshold the

@@ -8,28 +8,34 @@
 #include <sstream>
 #include <utility>
 
+#include "scene/format.hpp"
+#include "solver/field_plan.hpp"
 #include "solver/simulation.hpp"
 
 namespace mmpm {
 namespace {
 
+// A pair of velocity fields the multimaterial pass treats with a contact
+// law, and the closest their particles come.
 struct OpenContact {
-  std::size_t interaction = 0;  // index into scene.interactions
-  double nearest = 0;           // closest particles of the two materials (inf: none near)
-  double touching = 0;          // the largest distance that counts as touching
+  int law = 0;         // index into FieldPlan::laws: an interaction, or the default law after them
+  int fields[2]{0, 0};  // the pair's velocity fields
+  double nearest = 0;   // closest particles of the two fields (inf: none near)
+  double touching = 0;  // the largest distance that counts as touching
 };
 
 bool is_contact_law(Law law) {
   return law == Law::stick || law == Law::frictionless || law == Law::friction;
 }
 
-// The particle spacing of a material's bodies, the largest over directions
-// and bodies (0: the material has no body).
-double spacing_of(const Scene& scene, const std::string& material) {
+// The particle spacing of a field's bodies, the largest over directions
+// and bodies (0: the field has no body).
+double spacing_of(const Scene& scene, const FieldPlan& plan, int field) {
   double s = 0;
   const int dim = scene.simulation.dimension;
   for (const auto& b : scene.bodies) {
-    if (b.material != material) continue;
+    const int m = scene.material_index(b.material);
+    if (m < 0 || plan.field_of_material[std::size_t(m)] != field) continue;
     for (int d = 0; d < dim; ++d)
       s = std::max(s, scene.grid.cell[std::size_t(d)] / double(b.particles_per_cell));
   }
@@ -59,10 +65,10 @@ struct CellGrid {
 };
 
 Binned bin(const CellGrid& g, const std::vector<double>& x, const std::vector<double>& mat,
-           int material) {
+           const FieldPlan& plan, int field) {
   Binned out;
   for (std::size_t p = 0; p < mat.size(); ++p)
-    if (int(mat[p]) == material)
+    if (plan.field_of_material[std::size_t(mat[p])] == field)
       out.emplace_back(g.key(g.cell_of(&x[p * std::size_t(g.dim)])), std::uint32_t(p));
   std::sort(out.begin(), out.end());
   return out;
@@ -105,13 +111,21 @@ double nearest_pair(const CellGrid& g, const std::vector<double>& x, const Binne
   return best;
 }
 
-std::vector<OpenContact> open_contacts(const Scene& scene, const Simulation& sim) {
+std::vector<OpenContact> open_contacts(const Scene& scene, const FieldPlan& plan,
+                                       const Simulation& sim) {
   std::vector<OpenContact> out;
-  std::vector<std::size_t> checked;
-  for (std::size_t i = 0; i < scene.interactions.size(); ++i) {
-    const InteractionSpec& it = scene.interactions[i];
-    if (is_contact_law(it.law) && it.separation == Separation::displacement) checked.push_back(i);
-  }
+  if (!plan.multimaterial || plan.position_separation) return out;
+  // Every pair of fields under a contact law, the default law's pairs
+  // included; two rigid fields never meet in the multimaterial pass.
+  std::vector<OpenContact> checked;
+  const std::size_t F = std::size_t(plan.fields);
+  for (std::size_t a = 0; a < F; ++a)
+    for (std::size_t b = a + 1; b < F; ++b) {
+      const int l = plan.pair[a * F + b];
+      if (l < 0 || !is_contact_law(plan.laws[std::size_t(l)].law)) continue;
+      if (plan.rigid[a] && plan.rigid[b]) continue;
+      checked.push_back({l, {int(a), int(b)}, 0, 0});
+    }
   if (checked.empty()) return out;
 
   CellGrid g;
@@ -123,40 +137,59 @@ std::vector<OpenContact> open_contacts(const Scene& scene, const Simulation& sim
   }
   const std::vector<double> x = sim.particle_field("position").values;
   const std::vector<double> mat = sim.particle_field("material").values;
-  for (const std::size_t i : checked) {
-    const InteractionSpec& it = scene.interactions[i];
-    const int ma = scene.material_index(it.materials[0]);
-    const int mb = scene.material_index(it.materials[1]);
-    const double sa = spacing_of(scene, it.materials[0]), sb = spacing_of(scene, it.materials[1]);
-    if (ma < 0 || mb < 0 || sa == 0 || sb == 0) continue;  // a material without particles
-    const double touching = 0.75 * (sa + sb);
+  for (OpenContact c : checked) {
+    const double sa = spacing_of(scene, plan, c.fields[0]);
+    const double sb = spacing_of(scene, plan, c.fields[1]);
+    if (sa == 0 || sb == 0) continue;  // a field without particles
+    c.touching = 0.75 * (sa + sb);
     std::array<long, 3> reach{0, 0, 0};
     for (int d = 0; d < g.dim; ++d)
-      reach[std::size_t(d)] = long(std::ceil(touching / g.h[std::size_t(d)]));
-    Binned a = bin(g, x, mat, ma), b = bin(g, x, mat, mb);
+      reach[std::size_t(d)] = long(std::ceil(c.touching / g.h[std::size_t(d)]));
+    Binned a = bin(g, x, mat, plan, c.fields[0]), b = bin(g, x, mat, plan, c.fields[1]);
     if (a.empty() || b.empty()) continue;
     if (a.size() > b.size()) std::swap(a, b);  // walk the cells of the smaller set
-    double nearest = nearest_pair(g, x, a, b, reach, touching);
+    c.nearest = nearest_pair(g, x, a, b, reach, c.touching);
     // The search sees every pair up to `reach` cells apart; a larger
     // distance found is not known to be the nearest.
     double seen = std::numeric_limits<double>::infinity();
     for (int d = 0; d < g.dim; ++d)
       seen = std::min(seen, double(reach[std::size_t(d)]) * g.h[std::size_t(d)]);
-    if (nearest > seen * (1 + 1e-9)) nearest = std::numeric_limits<double>::infinity();
-    if (nearest > touching) out.push_back({i, nearest, touching});
+    if (c.nearest > seen * (1 + 1e-9)) c.nearest = std::numeric_limits<double>::infinity();
+    if (c.nearest > c.touching) out.push_back(c);
   }
   return out;
 }
 
-std::string open_contact_warning(const Scene& scene, const OpenContact& c) {
-  const InteractionSpec& it = scene.interactions[c.interaction];
+// The materials of a field, quoted and joined ("'a'", "'a' and 'b'").
+std::string materials_of(const Scene& scene, const FieldPlan& plan, int field) {
+  std::vector<std::string> names;
+  for (std::size_t m = 0; m < scene.materials.size(); ++m)
+    if (plan.field_of_material[m] == field) names.push_back("'" + scene.materials[m].name + "'");
+  std::string s;
+  for (std::size_t i = 0; i < names.size(); ++i)
+    s += (i == 0 ? "" : i + 1 == names.size() ? " and " : ", ") + names[i];
+  return s;
+}
+
+std::string open_contact_warning(const Scene& scene, const FieldPlan& plan,
+                                 const OpenContact& c) {
   std::ostringstream m;
   m.precision(4);
-  m << (it.where.file.empty() ? scene.source_file : it.where.file);
-  if (it.where.line > 0) m << ":" << it.where.line;
-  m << ": warning: key 'interaction[" << c.interaction << "].separation': materials '"
-    << it.materials[0] << "' and '" << it.materials[1]
-    << "' start apart (their nearest particles are ";
+  const std::size_t l = std::size_t(c.law);
+  if (l < scene.interactions.size()) {  // plan.laws starts with the scene's interactions
+    const InteractionSpec& it = scene.interactions[l];
+    m << (it.where.file.empty() ? scene.source_file : it.where.file);
+    if (it.where.line > 0) m << ":" << it.where.line;
+    m << ": warning: key 'interaction[" << l << "].separation': materials '" << it.materials[0]
+      << "' and '" << it.materials[1] << "' start apart";
+  } else {
+    m << scene.source_file << ": warning: key 'simulation.default_law' ("
+      << scene_name(plan.laws[l].law) << ", displacement separation): "
+      << materials_of(scene, plan, c.fields[0]) << " and "
+      << materials_of(scene, plan, c.fields[1])
+      << " share no [[interaction]], so the default law applies, and they start apart";
+  }
+  m << " (their nearest particles are ";
   if (std::isfinite(c.nearest))
     m << c.nearest;
   else
@@ -165,6 +198,8 @@ std::string open_contact_warning(const Scene& scene, const OpenContact& c) {
     << "). With separation = \"displacement\" they count as in contact as soon as their "
        "particles share grid nodes, a cell or more before their surfaces meet; separation = "
        "\"position\" is meant for bodies that start apart";
+  if (l >= scene.interactions.size())
+    m << " (an [[interaction]] of theirs, or default_law = \"separate\" if they never meet)";
   return m.str();
 }
 
@@ -172,8 +207,9 @@ std::string open_contact_warning(const Scene& scene, const OpenContact& c) {
 
 std::vector<std::string> open_contact_warnings(const Scene& scene, const Simulation& sim) {
   std::vector<std::string> out;
-  for (const OpenContact& c : open_contacts(scene, sim))
-    out.push_back(open_contact_warning(scene, c));
+  const FieldPlan plan = plan_fields(scene);
+  for (const OpenContact& c : open_contacts(scene, plan, sim))
+    out.push_back(open_contact_warning(scene, plan, c));
   return out;
 }
 

@@ -17,12 +17,14 @@ namespace mmpm {
 
 class Simulation;
 
-// One warning per contact interaction (stick, frictionless, friction) with
-// separation = "displacement" whose two materials have no pair of particles
-// closer than 1.5 mean particle spacings (spacing: cell /
-// particles_per_cell, the largest over directions and over the material's
+// One warning per pair of velocity fields under a contact law (stick,
+// frictionless, friction; an [[interaction]] or [simulation] default_law,
+// not two rigid fields) with separation = "displacement" whose particles
+// have no pair closer than 1.5 mean particle spacings (spacing: cell /
+// particles_per_cell, the largest over directions and over the fields'
 // bodies) in the simulation's current (initial) state:
-// "FILE:LINE: warning: key 'interaction[i].separation': ...".
+// "FILE:LINE: warning: key 'interaction[i].separation': ..." or
+// "FILE: warning: key 'simulation.default_law' (...): ...".
 std::vector<std::string> open_contact_warnings(const Scene& scene, const Simulation& sim);
 
 }  // namespace mmpm
