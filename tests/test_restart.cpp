@@ -187,6 +187,17 @@ void expect_same_run(const RunFile& ref, const RunFile& got) {
   EXPECT_GE(compared, 7);
 }
 
+// The uninterrupted run of `scene` into dir (step 1 of both tests below).
+json reference_run(const fs::path& scene, const fs::path& dir, double* seconds) {
+  const CmdResult ref =
+      run_mmpm({"run", scene.string(), "--out", dir.string(), "--threads", "1", "--quiet"});
+  EXPECT_EQ(ref.exit_code, 0) << ref.describe();
+  if (seconds) *seconds = ref.seconds;
+  if (ref.exit_code != 0) return json();
+  EXPECT_FALSE(fs::exists(dir / "checkpoint.bin")) << "a completed run removes its checkpoint";
+  return json::parse(read_text(dir / "summary.json"));
+}
+
 void check_killed_run_continues_bitwise(const std::string& scene_text) {
   TempDir tmp;
   const fs::path scene = tmp / "restart_scene.toml";
@@ -194,13 +205,11 @@ void check_killed_run_continues_bitwise(const std::string& scene_text) {
 
   // 1. The uninterrupted run.
   const fs::path ref_dir = tmp / "ref";
-  const CmdResult ref =
-      run_mmpm({"run", scene.string(), "--out", ref_dir.string(), "--threads", "1", "--quiet"});
-  ASSERT_EQ(ref.exit_code, 0) << ref.describe();
-  const json ref_summary = json::parse(read_text(ref_dir / "summary.json"));
+  double ref_seconds = 0;
+  const json ref_summary = reference_run(scene, ref_dir, &ref_seconds);
+  ASSERT_FALSE(ref_summary.is_null());
   const long steps = ref_summary.at("steps").get<long>();
   ASSERT_GT(steps, 100);
-  EXPECT_FALSE(fs::exists(ref_dir / "checkpoint.bin")) << "a completed run removes its checkpoint";
 
   // 2. The same run, killed part-way (after its first checkpoint). If the
   // machine is so fast the run ends first, try again killing earlier.
@@ -215,7 +224,7 @@ void check_killed_run_continues_bitwise(const std::string& scene_text) {
     while (!child.poll_done()) {
       const double elapsed =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      if (fs::exists(dir / "checkpoint.bin") && elapsed >= fraction * ref.seconds) {
+      if (fs::exists(dir / "checkpoint.bin") && elapsed >= fraction * ref_seconds) {
         child.kill_and_wait(SIGKILL);
         killed = child.result().signal == SIGKILL;
         break;
@@ -275,6 +284,51 @@ void check_killed_run_continues_bitwise(const std::string& scene_text) {
 
 TEST(Restart, KilledRunContinuesBitwise) {
   check_killed_run_continues_bitwise(kScene);
+}
+
+// A run whose output cannot grow (a full disk; here a file size limit,
+// `ulimit -f`, with SIGXFSZ ignored so that the write fails with EFBIG as
+// it does with ENOSPC) stops with exit 3 and one line naming the file and
+// the system's reason; it leaves no run.h5 or summary.json, and its last
+// checkpoint restarts it, once there is room, to the uninterrupted run's
+// results bitwise. HDF5's exit handler used to crash the process (SIGSEGV
+// after the message) closing the file whose writes had failed (io/h5.cpp).
+// The limit, 1500 KiB, is about 4 of the scene's 11 snapshots (~0.3 MB
+// each); the checkpoint (~0.6 MB) fits under it.
+TEST(Restart, RunStoppedByAFullDiskContinuesBitwise) {
+  TempDir tmp;
+  const fs::path scene = tmp / "restart_scene.toml";
+  write_text(scene, kScene);
+  const fs::path ref_dir = tmp / "ref";
+  const json ref_summary = reference_run(scene, ref_dir, nullptr);
+  ASSERT_FALSE(ref_summary.is_null());
+
+  const fs::path dir = tmp / "full";
+  const CmdResult full = run_command(
+      {"/bin/bash", "-c",
+       "trap '' XFSZ; ulimit -f 1500; exec \"$0\" run \"$1\" --out \"$2\" --threads 1 --quiet",
+       mmpm_binary(), scene.string(), dir.string()});
+  EXPECT_EQ(full.signal, 0) << full.describe();
+  ASSERT_EQ(full.exit_code, 3) << full.describe();
+  ASSERT_EQ(lines_of(full.err).size(), 1u) << full.describe();
+  EXPECT_TRUE(contains(full.err, "run.h5.partial")) << full.err;
+  EXPECT_TRUE(contains(full.err, "File too large")) << full.err;
+  EXPECT_FALSE(fs::exists(dir / "run.h5")) << "a failed run must not look finished";
+  EXPECT_FALSE(fs::exists(dir / "summary.json")) << "a failed run must not look finished";
+  ASSERT_TRUE(fs::exists(dir / "checkpoint.bin"));
+  const auto blobs = mmpm::io::read_checkpoint(dir / "checkpoint.bin");
+  const long ckpt_step = mmpm::io::read_scalar_blob<long>(mmpm::io::find_blob(blobs, "step"));
+  EXPECT_GT(ckpt_step, 0);
+  EXPECT_LT(ckpt_step, ref_summary.at("steps").get<long>());
+
+  const CmdResult again = run_mmpm({"run", "--restart", dir.string(), "--threads", "1", "--quiet"});
+  ASSERT_EQ(again.exit_code, 0) << again.describe();
+  expect_same_run(read_run(ref_dir / "run.h5"), read_run(dir / "run.h5"));
+  const json got = json::parse(read_text(dir / "summary.json"));
+  EXPECT_EQ(got.at("steps"), ref_summary.at("steps"));
+  for (const char* e : {"kinetic", "strain", "interface", "external_work", "damping"})
+    EXPECT_EQ(got.at("energy").at(e).get<double>(), ref_summary.at("energy").at(e).get<double>())
+        << e;
 }
 
 // The same in float, whose particles carry one more column per axis, the

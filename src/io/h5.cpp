@@ -9,6 +9,17 @@ namespace mmpm::io::h5 {
 
 namespace {
 
+// HDF5 closes the files still open when the process exits (an atexit
+// handler). A file whose write failed (a full disk) stays open, since its
+// close fails too, and the handler's second close crashed the process after
+// its error message (SIGSEGV in H5F__close_cb, HDF5 1.10.8). Every file is
+// closed by its owner (Id), so the handler has nothing else to do; it is
+// switched off before the library starts, which is the only time it can be.
+[[maybe_unused]] const bool kNoExitHandler = [] {
+  H5dont_atexit();
+  return true;
+}();
+
 // Sweeps run several scenes in threads of one process. The Debian build is
 // thread-safe, but a serial non-thread-safe build is common elsewhere; one
 // process-wide lock around every call makes both safe at no measurable cost
@@ -39,9 +50,21 @@ struct StackText {
   std::string inner;  // the deepest cause (often the errno text)
 };
 
+// A failed system call's description spans lines and lists the buffer,
+// offset and time; its "error message = '...'" is the part a user needs.
+std::string system_error_text(const std::string& desc) {
+  const std::string key = "error message = '";
+  const std::size_t at = desc.find(key);
+  if (at == std::string::npos) return desc;
+  const std::size_t from = at + key.size(), to = desc.find('\'', from);
+  return to == std::string::npos ? desc : desc.substr(from, to - from);
+}
+
 herr_t collect(unsigned n, const H5E_error2_t* err, void* data) {
   auto* text = static_cast<StackText*>(data);
-  const std::string desc = err->desc != nullptr ? err->desc : "";
+  std::string desc = system_error_text(err->desc != nullptr ? err->desc : "");
+  for (char& c : desc)
+    if (c == '\n') c = ' ';
   if (n == 0) text->outer = desc;
   text->inner = desc;
   return 0;

@@ -282,6 +282,22 @@ void RunWriter::require_open(const char* operation) const {
   }
 }
 
+namespace {
+
+// HDF5's errors name a dataset or an operation ("cannot write dataset
+// 'stress': ... (File too large)"); the user needs the file too.
+[[noreturn]] void rethrow_naming(const fs::path& file) {
+  try {
+    throw;
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    if (what.find(file.string()) != std::string::npos) throw;
+    throw std::runtime_error(file.string() + ": " + what);
+  }
+}
+
+}  // namespace
+
 void RunWriter::set_attribute(const std::string& name, const std::string& value) {
   require_open("set_attribute");
   file_->root().set_string_attribute(name, value);
@@ -302,7 +318,7 @@ void RunWriter::write_snapshot(const Snapshot& snapshot) {
       remove_snapshot(root, name);
     } catch (...) {
     }
-    throw;
+    rethrow_naming(partial_path());
   }
   file_->flush();
 }
@@ -328,12 +344,16 @@ void RunWriter::write_series(const std::vector<std::string>& names,
     }
     list += (i == 0 ? "" : ",") + names[i];
   }
-  h5::Group root = file_->root();
-  remove_if_present(root, series_group);
-  h5::Group series = root.create_group(series_group);
-  series.set_string_attribute("columns", list);
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    series.write_doubles(names[i], columns[i], {static_cast<hsize_t>(columns[i].size())});
+  try {
+    h5::Group root = file_->root();
+    remove_if_present(root, series_group);
+    h5::Group series = root.create_group(series_group);
+    series.set_string_attribute("columns", list);
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      series.write_doubles(names[i], columns[i], {static_cast<hsize_t>(columns[i].size())});
+    }
+  } catch (...) {
+    rethrow_naming(partial_path());
   }
   file_->flush();
 }
