@@ -8,13 +8,16 @@
 // and ns_per_particle_step = wall_s 1e9 / (particles steps) to 1e-9
 // relative (both are computed from the same doubles; JSON keeps 17 digits).
 #include <gtest/gtest.h>
+#include <signal.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <regex>
 #include <set>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "io/h5.hpp"
@@ -565,9 +568,9 @@ particles_per_cell = 2
   EXPECT_EQ(separate.exit_code, 0) << separate.describe();
   EXPECT_EQ(separate.err, "") << separate.describe();
 
-  const CmdResult one = run_mmpm({"check", scene.string(), "--set", disp, "--set", touch_ab,
-                                  "--set", "body[2].max=[10.0, 7.5]", "--set",
-                                  "body[2].min=[2.0, 6.0]"});
+  const CmdResult one =
+      run_mmpm({"check", scene.string(), "--set", disp, "--set", touch_ab, "--set",
+                "body[2].max=[10.0, 7.5]", "--set", "body[2].min=[2.0, 6.0]"});
   EXPECT_EQ(one.exit_code, 0) << one.describe();
   const auto one_lines = lines_of(one.err);
   ASSERT_EQ(one_lines.size(), 1u) << one.describe();
@@ -644,6 +647,45 @@ TEST(Cli, SweepFailedRowKeepsTheColumns) {
   EXPECT_TRUE(contains(rows[2], ",failed,")) << rows[2];
   EXPECT_TRUE(contains(csv_fields(rows[2])[std::size_t(msg_col)], "unstable")) << rows[2];
   EXPECT_TRUE(csv_fields(rows[1])[std::size_t(msg_col)].empty()) << rows[1];
+}
+
+// SIGTERM to a sweep (a batch system's wall-time limit): the row running
+// stops with a checkpoint (app/interrupt.hpp), the rows not started are
+// not run, sweep.csv says so row by row ("interrupted"), and the sweep
+// exits 128 + 15. Rows: bar_vibration.toml (400 particles) for 100 ms,
+// ~2.5 M steps, minutes each; one job, so rows 1 and 2 wait.
+TEST(Cli, InterruptedSweepMarksItsRows) {
+  TempDir tmp;
+  const fs::path out = tmp / "sweep";
+  Child child({mmpm_binary(), "sweep", bar_scene(), "--param", "simulation.end_time", "--values",
+               "100,101,102", "--jobs", "1", "--threads", "1", "--quiet", "--out", out.string()},
+              tmp / "sweep.out", tmp / "sweep.err");
+  const auto t0 = std::chrono::steady_clock::now();
+  while (!fs::exists(out / "0" / "run.h5.partial") && !child.poll_done() &&
+         std::chrono::steady_clock::now() - t0 < std::chrono::seconds(60))
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ASSERT_FALSE(child.poll_done()) << read_text(tmp / "sweep.err");
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  child.kill_and_wait(SIGTERM);
+  EXPECT_EQ(child.result().signal, 0);
+  EXPECT_EQ(child.result().exit_code, 128 + SIGTERM) << read_text(tmp / "sweep.err");
+  const auto rows = lines_of(read_text(out / "sweep.csv"));
+  ASSERT_EQ(rows.size(), 4u);
+  const auto header = csv_fields(rows[0]);
+  const auto msg_col =
+      std::size_t(std::find(header.begin(), header.end(), "message") - header.begin());
+  ASSERT_LT(msg_col, header.size());
+  EXPECT_TRUE(contains(rows[1], ",interrupted,")) << rows[1];
+  EXPECT_TRUE(
+      contains(csv_fields(rows[1])[msg_col],
+               "checkpoint written: continue with `mmpm run --restart " + (out / "0").string()))
+      << rows[1];
+  EXPECT_TRUE(fs::exists(out / "0" / "checkpoint.bin"));
+  EXPECT_FALSE(fs::exists(out / "0" / "summary.json"));
+  for (std::size_t k = 2; k <= 3; ++k) {
+    EXPECT_TRUE(contains(rows[k], ",interrupted,")) << rows[k];
+    EXPECT_EQ(csv_fields(rows[k])[msg_col], "not run: interrupted by SIGTERM") << rows[k];
+  }
 }
 
 TEST(Cli, SweepWritesTableAndOneSummaryPerValue) {

@@ -331,6 +331,88 @@ TEST(Restart, RunStoppedByAFullDiskContinuesBitwise) {
         << e;
 }
 
+// Ctrl-C or a batch system's SIGTERM (app/interrupt.hpp) stops the run
+// between two steps with a checkpoint, even with checkpoint_minutes = 0 as
+// here: exit 128 + signal, one stderr line that says how to continue, no
+// run.h5 or summary.json; `--restart` then ends bitwise equal to the
+// uninterrupted run. Until 2026-11-28 the signal killed the process and,
+// without periodic checkpoints, lost the whole run. The signal is sent
+// once the run has written its first snapshot and a third of the
+// reference run's time has passed; a run that ends first is retried.
+void check_interrupted_run_continues_bitwise(int sig, const char* name) {
+  TempDir tmp;
+  const fs::path scene = tmp / "restart_scene.toml";
+  std::string text = kScene;
+  const std::string every = "checkpoint_minutes = 1.0e-5";
+  ASSERT_NE(text.find(every), std::string::npos);
+  text.replace(text.find(every), every.size(), "checkpoint_minutes = 0");
+  write_text(scene, text);
+  const fs::path ref_dir = tmp / "ref";
+  double ref_seconds = 0;
+  const json ref_summary = reference_run(scene, ref_dir, &ref_seconds);
+  ASSERT_FALSE(ref_summary.is_null());
+
+  const fs::path dir = tmp / "stopped";
+  bool stopped = false;
+  for (double fraction : {0.33, 0.1, 0.0}) {
+    fs::remove_all(dir);
+    Child child(
+        {mmpm_binary(), "run", scene.string(), "--out", dir.string(), "--threads", "1", "--quiet"},
+        tmp / "stopped.out", tmp / "stopped.err");
+    const auto t0 = std::chrono::steady_clock::now();
+    while (!child.poll_done()) {
+      const double elapsed =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      if (fs::exists(dir / "run.h5.partial") && elapsed >= fraction * ref_seconds) {
+        child.kill_and_wait(sig);
+        stopped = true;
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    if (stopped) {
+      const CmdResult& r = child.result();
+      if (r.exit_code == 0 && fs::exists(dir / "summary.json")) {
+        stopped = false;  // the signal came after the last step: a finished run
+        continue;
+      }
+      EXPECT_EQ(r.signal, 0) << name << " killed the process";
+      EXPECT_EQ(r.exit_code, 128 + sig);
+      break;
+    }
+    ASSERT_EQ(child.result().exit_code, 0) << read_text(tmp / "stopped.err");
+  }
+  ASSERT_TRUE(stopped) << "could not stop the run before it finished";
+  const std::string err = read_text(tmp / "stopped.err");
+  ASSERT_EQ(lines_of(err).size(), 1u) << err;
+  EXPECT_TRUE(contains(err, std::string("interrupted by ") + name)) << err;
+  EXPECT_TRUE(contains(err, "mmpm run --restart " + dir.string())) << err;
+  EXPECT_FALSE(fs::exists(dir / "run.h5")) << "a stopped run must not look finished";
+  EXPECT_FALSE(fs::exists(dir / "summary.json")) << "a stopped run must not look finished";
+  ASSERT_TRUE(fs::exists(dir / "checkpoint.bin"));
+  const auto blobs = mmpm::io::read_checkpoint(dir / "checkpoint.bin");
+  const long ckpt_step = mmpm::io::read_scalar_blob<long>(mmpm::io::find_blob(blobs, "step"));
+  EXPECT_GT(ckpt_step, 0);
+  EXPECT_LT(ckpt_step, ref_summary.at("steps").get<long>());
+
+  const CmdResult again = run_mmpm({"run", "--restart", dir.string(), "--threads", "1", "--quiet"});
+  ASSERT_EQ(again.exit_code, 0) << again.describe();
+  expect_same_run(read_run(ref_dir / "run.h5"), read_run(dir / "run.h5"));
+  const json got = json::parse(read_text(dir / "summary.json"));
+  EXPECT_EQ(got.at("steps"), ref_summary.at("steps"));
+  for (const char* e : {"kinetic", "strain", "interface", "external_work", "damping"})
+    EXPECT_EQ(got.at("energy").at(e).get<double>(), ref_summary.at("energy").at(e).get<double>())
+        << e;
+}
+
+TEST(Restart, SigtermStopsWithACheckpointAndContinuesBitwise) {
+  check_interrupted_run_continues_bitwise(SIGTERM, "SIGTERM");
+}
+
+TEST(Restart, SigintStopsWithACheckpointAndContinuesBitwise) {
+  check_interrupted_run_continues_bitwise(SIGINT, "SIGINT");
+}
+
 // The same in float, whose particles carry one more column per axis, the
 // positions' low parts (kernels/position_sum.hpp): a restart that lost it
 // would move every particle by up to half an ulp and differ in the bits.

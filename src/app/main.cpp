@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "app/build_info.hpp"
+#include "app/interrupt.hpp"
 #include "app/run_driver.hpp"
 #include "app/sweep.hpp"
 #include "scene/error.hpp"
@@ -100,6 +101,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (*check) return check_scene(check_file, check_sets);
+    mmpm::catch_interrupts();  // run and sweep stop between steps, with a checkpoint
     if (*sweep) {
       so.values = mmpm::split_values(values);
       if (so.values.empty()) {

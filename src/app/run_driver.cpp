@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "app/build_info.hpp"
+#include "app/interrupt.hpp"
 #include "app/output_directory.hpp"
 #include "app/timing_table.hpp"
 #include "io/atomic_file.hpp"
@@ -333,6 +334,18 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
       if (ckpt_s > 0 && std::chrono::duration<double>(Clock::now() - last_ckpt).count() >= ckpt_s) {
         checkpoint();
         last_ckpt = Clock::now();
+      }
+      if (const int sig = pending_interrupt()) {
+        // Stopped from outside (app/interrupt.hpp): keep what was computed.
+        checkpoint();
+        progress.done();
+        std::ostringstream m;
+        m << "interrupted by " << signal_name(sig) << " at step " << s << " (t = " << sim->time()
+          << " of " << end_time << "); checkpoint written: continue with `mmpm run --restart "
+          << dir.string() << "`";
+        out.exit_code = 128 + sig;
+        out.message = m.str();
+        return out;
       }
       progress.update(s, sim->time());
     }

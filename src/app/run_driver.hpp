@@ -23,7 +23,7 @@ struct RunOptions {
 };
 
 struct RunOutcome {
-  int exit_code = 0;       // 0 ok, 2 bad input, 3 unstable / failed
+  int exit_code = 0;       // 0 ok, 2 bad input, 3 unstable / failed, 128 + signal interrupted
   std::string message;     // error text when exit_code != 0
   nlohmann::json summary;  // summary.json contents when the run completed
   std::filesystem::path directory;

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <thread>
 
+#include "app/interrupt.hpp"
 #include "app/output_directory.hpp"
 #include "app/run_driver.hpp"
 #include "io/atomic_file.hpp"
@@ -74,7 +75,12 @@ int run_sweep(const SweepOptions& opt) {
       ro.warnings = k == 0;  // the scene's warnings once, not once per value
       std::ostringstream log;
       try {
-        results[k] = run_scene(scenes[k], ro, log);
+        if (const int sig = pending_interrupt()) {  // the rows not started yet
+          results[k].exit_code = 128 + sig;
+          results[k].message = std::string("not run: interrupted by ") + signal_name(sig);
+        } else {
+          results[k] = run_scene(scenes[k], ro, log);
+        }
       } catch (const InputError& e) {
         results[k].exit_code = 2;
         results[k].message = e.what();
@@ -91,10 +97,14 @@ int run_sweep(const SweepOptions& opt) {
   csv << "index,value,status,steps,end_time,wall_s,ns_per_particle_step,kinetic,strain,interface,"
          "external_work,damping,multimaterial_nodes,force_limited_nodes,stopped_by,directory,"
          "message\n";
-  int code = 0;
+  int code = 0, interrupted_code = 0;  // an interruption's 128 + signal wins over 3
   for (std::size_t k = 0; k < n; ++k) {
     const auto& r = results[k];
-    csv << k << "," << csv_quoted(opt.values[k]) << "," << (r.exit_code == 0 ? "ok" : "failed")
+    const bool interrupted = r.exit_code > 128;
+    csv << k << "," << csv_quoted(opt.values[k]) << ","
+        << (r.exit_code == 0 ? "ok"
+            : interrupted    ? "interrupted"
+                             : "failed")
         << ",";
     if (r.exit_code == 0) {
       const auto& j = r.summary;
@@ -106,7 +116,10 @@ int run_sweep(const SweepOptions& opt) {
           << j["stopped_by"].get<std::string>();
     } else {
       csv << ",,,,,,,,,,,";  // the 12 columns steps .. stopped_by, empty
-      code = 3;
+      if (interrupted)
+        interrupted_code = r.exit_code;
+      else
+        code = 3;
     }
     // The message last, so that every row has the header's columns.
     csv << "," << (dir / std::to_string(k)).string() << ","
@@ -114,7 +127,7 @@ int run_sweep(const SweepOptions& opt) {
   }
   io::write_file_atomic(dir / "sweep.csv", csv.str());
   if (!opt.quiet) std::cerr << "wrote " << (dir / "sweep.csv").string() << "\n";
-  return code;
+  return interrupted_code != 0 ? interrupted_code : code;
 }
 
 }  // namespace mmpm

@@ -18,7 +18,7 @@ namespace {
 // A pair of velocity fields the multimaterial pass treats with a contact
 // law, and the closest their particles come.
 struct OpenContact {
-  int law = 0;         // index into FieldPlan::laws: an interaction, or the default law after them
+  int law = 0;          // index into FieldPlan::laws: an interaction, or the default law after them
   int fields[2]{0, 0};  // the pair's velocity fields
   double nearest = 0;   // closest particles of the two fields (inf: none near)
   double touching = 0;  // the largest distance that counts as touching
@@ -171,8 +171,7 @@ std::string materials_of(const Scene& scene, const FieldPlan& plan, int field) {
   return s;
 }
 
-std::string open_contact_warning(const Scene& scene, const FieldPlan& plan,
-                                 const OpenContact& c) {
+std::string open_contact_warning(const Scene& scene, const FieldPlan& plan, const OpenContact& c) {
   std::ostringstream m;
   m.precision(4);
   const std::size_t l = std::size_t(c.law);
@@ -184,8 +183,8 @@ std::string open_contact_warning(const Scene& scene, const FieldPlan& plan,
       << "' and '" << it.materials[1] << "' start apart";
   } else {
     m << scene.source_file << ": warning: key 'simulation.default_law' ("
-      << scene_name(plan.laws[l].law) << ", displacement separation): "
-      << materials_of(scene, plan, c.fields[0]) << " and "
+      << scene_name(plan.laws[l].law)
+      << ", displacement separation): " << materials_of(scene, plan, c.fields[0]) << " and "
       << materials_of(scene, plan, c.fields[1])
       << " share no [[interaction]], so the default law applies, and they start apart";
   }
