@@ -164,7 +164,7 @@ std::vector<double> ramp(std::size_t n, double start, double step) {
 Snapshot make_snapshot(int dimension, long step, double time, std::size_t count) {
   const double s = static_cast<double>(step);
   const int stress = dimension == 2 ? 4 : 6;
-  Snapshot snap{step, time, dimension, count, ramp(count * dimension, 0.5 + s, 0.25), {}};
+  Snapshot snap{step, time, dimension, count, ramp(count * dimension, 0.5 + s, 0.25), {}, {}};
   snap.fields.push_back({"displacement", dimension, ramp(count * dimension, s * 1e-3, 1e-4)});
   snap.fields.push_back({"velocity", dimension, ramp(count * dimension, -s, 0.1)});
   snap.fields.push_back({"stress", stress, ramp(count * stress, 100.0 + s, -1.5)});
@@ -765,7 +765,7 @@ TEST(IoRunWriter, EmptyParticleSetAndNoSnapshots) {
   ScratchDir scratch;
   {
     RunWriter writer(scratch.path() / "a");
-    writer.write_snapshot(Snapshot{0, 0.0, 3, 0, {}, {{"velocity", 3, {}}}});
+    writer.write_snapshot(Snapshot{0, 0.0, 3, 0, {}, {{"velocity", 3, {}}}, {}});
     writer.finish();
   }
   EXPECT_TRUE(fs::exists(scratch.path() / "a" / "run.xdmf"));

@@ -102,6 +102,7 @@ every = 0.025
 series = 10
 checkpoint_minutes = 1.0e-5
 fields = ["displacement", "velocity", "stress", "material"]
+grid_fields = ["mass", "velocity", "force"]
 )";
 
 // Everything run.h5 holds that a restart must reproduce.
@@ -109,6 +110,8 @@ struct RunFile {
   // snapshot group name -> dataset name -> values; plus the time/step attributes.
   std::map<std::string, std::map<std::string, std::vector<double>>> snapshots;
   std::map<std::string, std::pair<double, std::int64_t>> snapshot_time_step;
+  // /grid: step group name -> quantity -> values (output.grid_fields).
+  std::map<std::string, std::map<std::string, std::vector<double>>> grid;
   std::vector<std::string> columns;
   std::map<std::string, std::vector<double>> series;
 };
@@ -124,6 +127,15 @@ RunFile read_run(const fs::path& file) {
     r.snapshot_time_step[name] = {g.double_attribute("time"), g.int_attribute("step")};
     for (const std::string& ds : g.children())
       r.snapshots[name][ds] = g.open_dataset(ds).read_doubles();
+  }
+  if (root.contains("grid")) {
+    const h5::Group grid = root.open_group("grid");
+    for (const std::string& name : grid.children()) {
+      if (name.rfind("step_", 0) != 0) continue;
+      const h5::Group g = grid.open_group(name);
+      for (const std::string& ds : g.children())
+        r.grid[name][ds] = g.open_dataset(ds).read_doubles();
+    }
   }
   const h5::Group series = root.open_group("series");
   std::string list = series.string_attribute("columns");
@@ -169,6 +181,19 @@ void expect_same_run(const RunFile& ref, const RunFile& got) {
       ASSERT_TRUE(other.count(ds)) << name << "/" << ds << " missing after restart";
       EXPECT_TRUE(same_bits(values, other.at(ds)))
           << name << "/" << ds << " differs: " << first_diff(values, other.at(ds));
+    }
+  }
+  // Grid snapshots: the same steps and quantities, bitwise equal.
+  EXPECT_EQ(ref.grid.size(), ref.snapshots.size()) << "a grid snapshot with every snapshot";
+  EXPECT_EQ(ref.grid.size(), got.grid.size());
+  for (const auto& [name, quantities] : ref.grid) {
+    ASSERT_TRUE(got.grid.count(name)) << "grid " << name << " missing after restart";
+    EXPECT_EQ(quantities.size(), got.grid.at(name).size()) << name;
+    EXPECT_TRUE(quantities.count("velocity.a") && quantities.count("force.b")) << name;
+    for (const auto& [q, values] : quantities) {
+      ASSERT_TRUE(got.grid.at(name).count(q)) << name << "/" << q;
+      EXPECT_TRUE(same_bits(values, got.grid.at(name).at(q)))
+          << "grid " << name << "/" << q << ": " << first_diff(values, got.grid.at(name).at(q));
     }
   }
   // Series: same columns; all but the wall-clock timings bitwise equal.

@@ -276,7 +276,9 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
     const bool due = every > 0 && t >= double(st.next_snapshot) * every - 0.5 * sim->dt();
     if (!(due || (final && st.last_snapshot_step != sim->step_count()))) return;
     const auto t0 = Clock::now();
-    writer->write_snapshot(sim->snapshot(o.fields));
+    io::Snapshot snapshot = sim->snapshot(o.fields);
+    snapshot.grid = sim->grid_snapshot(o.grid_fields);
+    writer->write_snapshot(snapshot);
     st.last_snapshot_step = sim->step_count();
     if (every > 0) {
       // Jump straight to the first snapshot time after t: with `every` far

@@ -1,5 +1,6 @@
 #include "io/run_writer.hpp"
 
+#include <array>
 #include <cstdio>
 #include <initializer_list>
 #include <numeric>
@@ -21,6 +22,11 @@ namespace {
 constexpr const char* particles_group = "particles";
 constexpr const char* series_group = "series";
 constexpr const char* xdmf_group = "xdmf";
+constexpr const char* grid_group = "grid";
+constexpr const char* xdmf_grid_group = "xdmf_grid";  // padded 2D vectors of /grid
+// Every group that holds a snapshot's step_* children.
+constexpr std::array<const char*, 4> snapshot_groups{particles_group, xdmf_group, grid_group,
+                                                     xdmf_grid_group};
 constexpr const char* step_prefix = "step_";
 constexpr long max_step = 9'999'999'999;  // 10 digits keep name order == step order
 
@@ -103,6 +109,27 @@ void check_snapshot(const Snapshot& s) {
   }
 }
 
+void check_grid(const Snapshot& s) {
+  const GridSnapshot& g = s.grid;
+  const std::string where = "grid snapshot at step " + std::to_string(s.step) + ": ";
+  std::size_t nodes = 1;
+  for (int d = 0; d < 3; ++d) {
+    if (g.nodes[std::size_t(d)] < 1 || (d >= s.dimension && g.nodes[std::size_t(d)] != 1))
+      throw std::invalid_argument(where + "node counts must be >= 1 (1 beyond the dimension)");
+    nodes *= std::size_t(g.nodes[std::size_t(d)]);
+  }
+  std::set<std::string> names;
+  for (const ParticleField& f : g.fields) {
+    check_name(f.name, "grid field");
+    if (!names.insert(f.name).second)
+      throw std::invalid_argument(where + "field '" + f.name + "' given twice");
+    if (f.components < 1 || f.values.size() != nodes * std::size_t(f.components))
+      throw std::invalid_argument(where + "field '" + f.name + "' holds " +
+                                  std::to_string(f.values.size()) + " values, expected nodes x " +
+                                  std::to_string(f.components));
+  }
+}
+
 std::vector<double> padded_to_3(const std::vector<double>& xy, std::size_t count) {
   std::vector<double> xyz(3 * count, 0.0);
   for (std::size_t i = 0; i < count; ++i) {
@@ -116,19 +143,108 @@ void remove_if_present(h5::Group& group, const std::string& name) {
   if (group.contains(name)) group.remove(name);
 }
 
-// A snapshot lives in /particles and, for its padded 2D vectors, in /xdmf.
+// A snapshot lives in /particles and /grid and, for their padded 2D
+// vectors, in /xdmf and /xdmf_grid.
 void remove_snapshot(h5::Group& root, const std::string& name) {
-  for (const char* group_name : {particles_group, xdmf_group}) {
+  for (const char* group_name : snapshot_groups) {
     if (!root.contains(group_name)) continue;
     h5::Group group = root.open_group(group_name);
     remove_if_present(group, name);
   }
 }
 
-bool has_padded_copy(const h5::Group& root, const std::string& snapshot, const std::string& field) {
-  if (!root.contains(xdmf_group)) return false;
-  const h5::Group support = root.open_group(xdmf_group);
+bool has_padded_copy(const h5::Group& root, const std::string& snapshot, const std::string& field,
+                     const char* support_group = xdmf_group) {
+  if (!root.contains(support_group)) return false;
+  const h5::Group support = root.open_group(support_group);
   return support.contains(snapshot) && support.open_group(snapshot).contains(field);
+}
+
+// The HDF5 shape of a grid quantity: [nz,] ny, nx, components.
+std::vector<hsize_t> grid_shape(const GridSnapshot& g, int dimension, int components) {
+  std::vector<hsize_t> shape;
+  for (int d = dimension - 1; d >= 0; --d) shape.push_back(hsize_t(g.nodes[std::size_t(d)]));
+  shape.push_back(hsize_t(components));
+  return shape;
+}
+
+void write_grid_data(h5::Group& root, const Snapshot& s, const std::string& name) {
+  const GridSnapshot& g = s.grid;
+  const auto D = static_cast<std::size_t>(s.dimension);
+  h5::Group grid = root.require_group(grid_group);
+  // The geometry is the scene's, the same for every snapshot.
+  if (!grid.contains("origin")) {
+    grid.write_doubles("origin", std::vector<double>(g.origin.begin(), g.origin.begin() + D),
+                       {hsize_t(D)});
+    grid.write_doubles("spacing", std::vector<double>(g.spacing.begin(), g.spacing.begin() + D),
+                       {hsize_t(D)});
+  }
+  h5::Group group = grid.create_group(name);
+  group.set_int_attribute("step", s.step);
+  group.set_double_attribute("time", s.time);
+  std::size_t nodes = 1;
+  for (std::size_t d = 0; d < D; ++d) nodes *= std::size_t(g.nodes[d]);
+  for (const ParticleField& f : g.fields)
+    group.write_doubles(f.name, f.values, grid_shape(g, s.dimension, f.components));
+  if (s.dimension != 2) return;
+  bool any_vector = false;
+  for (const ParticleField& f : g.fields)
+    any_vector = any_vector || attribute_kind(f.components, 2) == AttributeKind::vector;
+  if (!any_vector) return;
+  // Shaped [1, ny, nx, 3], the rank of the 3D structured grid run_grid.xdmf
+  // describes: ParaView's XDMF reader selects vector data by the grid's
+  // dimensions and failed on [ny, nx, 3] ("selection + offset not within
+  // extent"; scalars read either way).
+  h5::Group padded = root.require_group(xdmf_grid_group).create_group(name);
+  std::vector<hsize_t> shape = grid_shape(g, 2, 3);
+  shape.insert(shape.begin(), 1);
+  for (const ParticleField& f : g.fields)
+    if (attribute_kind(f.components, 2) == AttributeKind::vector)
+      padded.write_doubles(f.name, padded_to_3(f.values, nodes), shape);
+}
+
+// What run_grid.xdmf must describe, read back from the file (after a
+// restart the file, not this process, knows every snapshot).
+std::vector<XdmfGridSnapshot> describe_grid(const h5::Group& root) {
+  std::vector<XdmfGridSnapshot> out;
+  if (!root.contains(grid_group)) return out;
+  const h5::Group grid = root.open_group(grid_group);
+  const std::vector<double> origin = grid.open_dataset("origin").read_doubles();
+  const std::vector<double> spacing = grid.open_dataset("spacing").read_doubles();
+  const int D = static_cast<int>(origin.size());
+  for (const std::string& name : grid.children()) {
+    if (parse_step_name(name) < 0) continue;
+    const h5::Group group = grid.open_group(name);
+    XdmfGridSnapshot s;
+    s.step = group.int_attribute("step");
+    s.time = group.double_attribute("time");
+    s.dimension = D;
+    for (int d = 0; d < D; ++d) {
+      s.origin[std::size_t(d)] = origin[std::size_t(d)];
+      s.spacing[std::size_t(d)] = spacing[std::size_t(d)];
+    }
+    for (const std::string& field : group.children()) {
+      const std::vector<hsize_t> shape = group.open_dataset(field).shape();
+      if (shape.size() != std::size_t(D) + 1)
+        throw std::runtime_error("run file: grid/" + name + "/" + field + " has the wrong rank");
+      for (int d = 0; d < D; ++d)
+        s.nodes[std::size_t(d)] = std::size_t(shape[std::size_t(D - 1 - d)]);
+      const int components = static_cast<int>(shape.back());
+      XdmfField f{field, attribute_kind(components, D), absolute({grid_group, name, field}),
+                  components};
+      if (f.kind == AttributeKind::vector && D == 2) {
+        if (has_padded_copy(root, name, field, xdmf_grid_group)) {
+          f.dataset = absolute({xdmf_grid_group, name, field});
+          f.stored_components = 3;
+        } else {
+          f.kind = AttributeKind::matrix;
+        }
+      }
+      s.fields.push_back(std::move(f));
+    }
+    out.push_back(std::move(s));
+  }
+  return out;
 }
 
 void write_snapshot_data(h5::Group& root, const Snapshot& s, const std::string& name) {
@@ -140,6 +256,8 @@ void write_snapshot_data(h5::Group& root, const Snapshot& s, const std::string& 
   for (const ParticleField& f : s.fields) {
     group.write_doubles(f.name, f.values, {n, static_cast<hsize_t>(f.components)});
   }
+
+  if (!s.grid.fields.empty()) write_grid_data(root, s, name);
 
   h5::Group support = root.require_group(xdmf_group);
   if (!support.contains(vertices_name(s.count))) {
@@ -222,6 +340,7 @@ RunWriter::RunWriter(const fs::path& dir) : dir_(dir) {
   fs::create_directories(dir_);
   fs::remove(h5_path());
   fs::remove(xdmf_path());
+  fs::remove(grid_xdmf_path());
   file_ = std::make_unique<h5::File>(h5::File::create(partial_path()));
   file_->root().set_int_attribute("mmpm_layout", 1);
 }
@@ -234,7 +353,7 @@ RunWriter RunWriter::reopen(const fs::path& dir, long last_step) {
   RunWriter writer(dir,
                    std::make_unique<h5::File>(h5::File::open(partial, h5::File::Mode::read_write)));
   h5::Group root = writer.file_->root();
-  for (const char* group_name : {particles_group, xdmf_group}) {
+  for (const char* group_name : snapshot_groups) {
     if (!root.contains(group_name)) continue;
     h5::Group group = root.open_group(group_name);
     for (const std::string& name : group.children()) {
@@ -245,6 +364,7 @@ RunWriter RunWriter::reopen(const fs::path& dir, long last_step) {
   writer.file_->flush();
   fs::remove(writer.h5_path());
   fs::remove(writer.xdmf_path());
+  fs::remove(writer.grid_xdmf_path());
   return writer;
 }
 
@@ -306,6 +426,7 @@ void RunWriter::set_attribute(const std::string& name, const std::string& value)
 void RunWriter::write_snapshot(const Snapshot& snapshot) {
   require_open("write_snapshot");
   check_snapshot(snapshot);
+  check_grid(snapshot);
   h5::Group root = file_->root();
   const std::string name = step_name(snapshot.step);
   remove_snapshot(root, name);
@@ -360,12 +481,14 @@ void RunWriter::write_series(const std::vector<std::string>& names,
 
 void RunWriter::finish() {
   require_open("finish");
-  std::string document;
+  std::string document, grid_document;
   {
     h5::Group root = file_->root();
     const std::vector<XdmfSnapshot> snapshots = describe(root);
     drop_unused_vertices(root, snapshots);
     document = xdmf_document("run.h5", snapshots);
+    const std::vector<XdmfGridSnapshot> grids = describe_grid(root);
+    if (!grids.empty()) grid_document = xdmf_grid_document("run.h5", grids);
   }  // every handle into the file is closed before the file itself
   file_->close();
   // The data must be on disk before the name that promises a complete result.
@@ -373,6 +496,7 @@ void RunWriter::finish() {
   fs::rename(partial_path(), h5_path());
   fsync_directory(dir_);
   write_file_atomic(xdmf_path(), document);
+  if (!grid_document.empty()) write_file_atomic(grid_xdmf_path(), grid_document);
 }
 
 void RunWriter::abandon() {

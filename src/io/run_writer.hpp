@@ -1,6 +1,8 @@
 // The run's results: DIR/run.h5 (particle snapshots, time series, the
 // resolved scene) and DIR/run.xdmf (opens run.h5 in ParaView).
 //
+// DIR/run_grid.xdmf opens /grid in ParaView when the run wrote grid data.
+//
 // While a run is going the file is DIR/run.h5.partial; only finish() gives it
 // its real name, so a run.h5 is always a complete result. A killed run leaves
 // its .partial behind for `mmpm run --restart` (see reopen()).
@@ -11,6 +13,9 @@
 //   /particles/step_0000000420  attributes step (int64), time (double)
 //       position                [count x dimension]
 //       <field>                 [count x components], one per ParticleField
+//   /grid/origin, /grid/spacing [dimension], the grid's first node and cell
+//   /grid/step_0000000420       attributes step, time; with output.grid_fields
+//       <quantity>              [nz x] ny x nx x components (x fastest)
 //   /series/<name>              1-D, one per time-series column; the group's
 //                               attribute "columns" lists the names in order,
 //                               comma-separated
@@ -19,6 +24,7 @@
 //                               should read /particles and /series
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <filesystem>
 #include <memory>
@@ -37,6 +43,16 @@ struct ParticleField {
   std::vector<double> values;  // count * components, particle-major
 };
 
+// Nodal quantities written with a snapshot (SCENE.md "grid fields on
+// request"): `fields` hold nodes * components values each, node-major with
+// x fastest (node (i, j, k) at i + nx (j + ny k)); empty: no grid data.
+struct GridSnapshot {
+  std::array<int, 3> nodes{1, 1, 1};  // per direction (cells + 1); 1 beyond the dimension
+  std::array<double, 3> origin{0, 0, 0};
+  std::array<double, 3> spacing{1, 1, 1};
+  std::vector<ParticleField> fields;
+};
+
 struct Snapshot {
   long step;
   double time;
@@ -44,6 +60,7 @@ struct Snapshot {
   std::size_t count;
   std::vector<double> position;  // count * dimension, particle-major
   std::vector<ParticleField> fields;
+  GridSnapshot grid;
 };
 
 class RunWriter {
@@ -71,7 +88,8 @@ class RunWriter {
   // machine description); replaces an attribute of the same name.
   void set_attribute(const std::string& name, const std::string& value);
 
-  // Writes /particles/step_<10-digit step>; a snapshot already present for
+  // Writes /particles/step_<10-digit step> (and /grid/step_<...> when the
+  // snapshot carries grid data); a snapshot already present for
   // that step is replaced. Flushed to the operating system before returning,
   // so a checkpoint written afterwards never refers to a snapshot the
   // partial file lacks. Throws std::invalid_argument on inconsistent sizes
@@ -84,7 +102,8 @@ class RunWriter {
                     const std::vector<std::vector<double>>& columns);
 
   // Closes the file, renames run.h5.partial to run.h5 (atomically, synced to
-  // disk), then writes run.xdmf describing every snapshot in the file.
+  // disk), then writes run.xdmf describing every snapshot in the file (and
+  // run_grid.xdmf for the grid snapshots, if any).
   void finish();
 
   // Closes and deletes the partial file: a failed run leaves nothing that
@@ -95,6 +114,7 @@ class RunWriter {
   std::filesystem::path h5_path() const { return dir_ / "run.h5"; }
   std::filesystem::path partial_path() const { return dir_ / "run.h5.partial"; }
   std::filesystem::path xdmf_path() const { return dir_ / "run.xdmf"; }
+  std::filesystem::path grid_xdmf_path() const { return dir_ / "run_grid.xdmf"; }
 
  private:
   RunWriter(std::filesystem::path dir, std::unique_ptr<h5::File> file);

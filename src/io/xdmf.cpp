@@ -57,6 +57,16 @@ const char* kind_name(AttributeKind kind) {
   return "Matrix";
 }
 
+// "<DataItem ...>" for a dataset of the given shape.
+void shaped_item(std::ostringstream& out, const std::string& indent,
+                 const std::vector<std::size_t>& shape, const std::string& h5_file,
+                 const std::string& dataset) {
+  out << indent << "<DataItem Dimensions=\"";
+  for (std::size_t i = 0; i < shape.size(); ++i) out << (i ? " " : "") << shape[i];
+  out << "\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << escaped(h5_file) << ':'
+      << escaped(dataset) << "</DataItem>\n";
+}
+
 void data_item(std::ostringstream& out, const std::string& indent, std::size_t rows, int columns,
                const char* number_type, const std::string& h5_file, const std::string& dataset) {
   out << indent << "<DataItem Dimensions=\"" << rows;
@@ -102,6 +112,54 @@ std::string xdmf_document(const std::string& h5_file, const std::vector<XdmfSnap
       out << in << "<Attribute Name=\"" << escaped(f.name) << "\" AttributeType=\""
           << kind_name(f.kind) << "\" Center=\"Node\">\n";
       data_item(out, in + "  ", s.count, f.stored_components, "Float", h5_file, f.dataset);
+      out << in << "</Attribute>\n";
+    }
+    out << "      </Grid>\n";
+  }
+  out << "    </Grid>\n"
+      << "  </Domain>\n"
+      << "</Xdmf>\n";
+  return out.str();
+}
+
+std::string xdmf_grid_document(const std::string& h5_file,
+                               const std::vector<XdmfGridSnapshot>& snapshots) {
+  std::ostringstream out;
+  out << "<?xml version=\"1.0\" ?>\n"
+      << "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n"
+      << "<Xdmf Version=\"3.0\">\n"
+      << "  <Domain>\n"
+      << "    <Grid Name=\"grid\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+  for (const XdmfGridSnapshot& s : snapshots) {
+    if (s.dimension != 2 && s.dimension != 3) {
+      throw std::invalid_argument("xdmf: dimension must be 2 or 3");
+    }
+    const std::string in = "        ";
+    // XDMF lists structured dimensions slowest first: z, y, x.
+    const std::size_t nz = s.dimension == 3 ? s.nodes[2] : 1;
+    const double oz = s.dimension == 3 ? s.origin[2] : 0.0;
+    const double hz = s.dimension == 3 ? s.spacing[2] : 1.0;
+    out << "      <Grid Name=\"step_" << s.step << "\" GridType=\"Uniform\">\n"
+        << in << "<Time Value=\"" << exact(s.time) << "\"/>\n"
+        << in << "<Topology TopologyType=\"3DCoRectMesh\" Dimensions=\"" << nz << ' ' << s.nodes[1]
+        << ' ' << s.nodes[0] << "\"/>\n"
+        << in << "<Geometry GeometryType=\"ORIGIN_DXDYDZ\">\n"
+        << in << "  <DataItem Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" "
+        << "Format=\"XML\">" << exact(oz) << ' ' << exact(s.origin[1]) << ' ' << exact(s.origin[0])
+        << "</DataItem>\n"
+        << in << "  <DataItem Dimensions=\"3\" NumberType=\"Float\" Precision=\"8\" "
+        << "Format=\"XML\">" << exact(hz) << ' ' << exact(s.spacing[1]) << ' '
+        << exact(s.spacing[0]) << "</DataItem>\n"
+        << in << "</Geometry>\n";
+    for (const XdmfField& f : s.fields) {
+      out << in << "<Attribute Name=\"" << escaped(f.name) << "\" AttributeType=\""
+          << kind_name(f.kind) << "\" Center=\"Node\">\n";
+      std::vector<std::size_t> shape;
+      // A 2D vector's padded copy has the 3D grid's rank (run_writer.cpp).
+      if (s.dimension == 2 && f.kind == AttributeKind::vector) shape.push_back(1);
+      for (int d = s.dimension - 1; d >= 0; --d) shape.push_back(s.nodes[std::size_t(d)]);
+      shape.push_back(std::size_t(f.stored_components));
+      shaped_item(out, in + "  ", shape, h5_file, f.dataset);
       out << in << "</Attribute>\n";
     }
     out << "      </Grid>\n";

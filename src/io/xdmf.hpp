@@ -3,6 +3,7 @@
 // decides which datasets exist.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -39,6 +40,24 @@ struct XdmfSnapshot {
   std::string connectivity;  // dataset [count] of 0..count-1 (one vertex cell per particle)
   std::vector<XdmfField> fields;
 };
+
+// One snapshot of the grid's nodal quantities (/grid/step_* in run.h5),
+// each dataset shaped [nz,] ny, nx, components.
+struct XdmfGridSnapshot {
+  long step = 0;
+  double time = 0;
+  int dimension = 2;
+  std::array<std::size_t, 3> nodes{1, 1, 1};  // per direction, x first
+  std::array<double, 3> origin{0, 0, 0};
+  std::array<double, 3> spacing{1, 1, 1};
+  std::vector<XdmfField> fields;
+};
+
+// run_grid.xdmf: one temporal collection of structured grids (3DCoRectMesh;
+// a 2D grid is one layer of nodes at z = 0, so that ParaView shows it in the
+// x-y plane), nodal attributes referenced as "H5_FILE_NAME:/path".
+std::string xdmf_grid_document(const std::string& h5_file_name,
+                               const std::vector<XdmfGridSnapshot>& snapshots);
 
 // The whole XDMF 3 document: one temporal collection of Polyvertex grids,
 // datasets referenced as "H5_FILE_NAME:/path" (relative, so the pair of files

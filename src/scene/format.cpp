@@ -282,13 +282,18 @@ void write_load(Writer& w, const LoadSpec& l) {
   w.num("ramp", l.ramp);
 }
 
+// ["a", "b"] as TOML.
+std::string quoted_list(const std::vector<std::string>& names) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < names.size(); ++i) out += (i > 0 ? ", " : "") + quoted(names[i]);
+  return out + "]";
+}
+
 void write_output(Writer& w, const OutputSpec& o) {
   w.section("[output]");
   w.num("every", o.every);
-  std::string fields = "[";
-  for (std::size_t i = 0; i < o.fields.size(); ++i)
-    fields += (i > 0 ? ", " : "") + quoted(o.fields[i]);
-  w.line("fields", fields + "]");
+  w.line("fields", quoted_list(o.fields));
+  if (!o.grid_fields.empty()) w.line("grid_fields", quoted_list(o.grid_fields));
   w.integer("series", o.series);
   w.num("checkpoint_minutes", o.checkpoint_minutes);
   w.str("directory", o.directory);

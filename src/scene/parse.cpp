@@ -1300,7 +1300,7 @@ class SceneReader {
 
   // ------------------------------------------------------ [output], [stop]
   void read_output(const Table& t) {
-    t.only({"every", "fields", "series", "checkpoint_minutes", "directory"});
+    t.only({"every", "fields", "grid_fields", "series", "checkpoint_minutes", "directory"});
     OutputSpec& o = scene_.output;
     if (auto f = t.get("every")) {
       o.every = f->non_negative();
@@ -1325,6 +1325,7 @@ class SceneReader {
             "field \"deformation_gradient\" needs a finite-strain (\"neohookean\") material; "
             "this scene has none (the small-strain types keep no F)");
     }
+    if (auto f = t.get("grid_fields")) o.grid_fields = names_from(*f, kGridFieldNames);
     if (auto f = t.get("series")) o.series = f->int_at_least(1);
     if (auto f = t.get("checkpoint_minutes")) o.checkpoint_minutes = f->non_negative();
     o.directory = "results/" + scene_.name;
@@ -1332,7 +1333,14 @@ class SceneReader {
   }
 
   static std::vector<std::string> output_fields(const Field& f) {
-    const Keys allowed(kOutputFieldNames.begin(), kOutputFieldNames.end());
+    return names_from(f, kOutputFieldNames);
+  }
+
+  // An array of distinct names, each from `names`.
+  template <std::size_t N>
+  static std::vector<std::string> names_from(const Field& f,
+                                             const std::array<std::string_view, N>& names) {
+    const Keys allowed(names.begin(), names.end());
     const std::string expected = "an array of field names from " + word_list(allowed, true);
     std::vector<std::string> out;
     for (const Field& e : f.elements(expected)) {

@@ -37,6 +37,8 @@ namespace mmpm {
 inline constexpr std::array<std::string_view, 9> kOutputFieldNames{
     "displacement",        "velocity", "stress", "strain", "material", "body", "mass", "volume",
     "deformation_gradient"};
+inline constexpr std::array<std::string_view, 4> kGridFieldNames{"mass", "momentum", "velocity",
+                                                                 "force"};
 
 // Reads and validates a scene file; `overrides` are "KEY=VALUE" strings
 // from --set, applied in order before validation.

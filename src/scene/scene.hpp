@@ -177,6 +177,9 @@ struct LoadSpec {
 struct OutputSpec {
   double every = 0.0;  // time between particle snapshots; 0 = only the last
   std::vector<std::string> fields{"displacement", "velocity", "stress", "material"};
+  // Nodal quantities written with every snapshot (SCENE.md "grid fields on
+  // request"): none by default.
+  std::vector<std::string> grid_fields;
   int series = 100;               // steps between series rows
   double checkpoint_minutes = 0;  // wall minutes between checkpoints; 0 = none
   std::string directory;          // default results/<scene name>

@@ -83,6 +83,10 @@ class Simulation {
   // particles in seed order: a particle keeps its row for the whole run).
   virtual io::ParticleField particle_field(const std::string& name) const = 0;
   virtual io::Snapshot snapshot(const std::vector<std::string>& fields) const = 0;
+  // Nodal quantities of the particles as they are now (output.grid_fields:
+  // mass, momentum, velocity, force), each summed over the velocity fields
+  // and, with more than one field, also per field ("velocity.<material>").
+  virtual io::GridSnapshot grid_snapshot(const std::vector<std::string>& quantities) const = 0;
   // Sets a per-particle quantity (velocity: D values per particle, in seed
   // order as particle_field) — for initial conditions the scene keys cannot express.
   virtual void set_particle_field(const std::string& name, const std::vector<double>& values) = 0;

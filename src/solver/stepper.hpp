@@ -6,6 +6,7 @@
 #include <omp.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -63,6 +64,7 @@ class Stepper final : public Simulation {
   std::vector<Reaction> reactions() const override;
   io::ParticleField particle_field(const std::string& name) const override;
   io::Snapshot snapshot(const std::vector<std::string>& fields) const override;
+  io::GridSnapshot grid_snapshot(const std::vector<std::string>& quantities) const override;
   void set_particle_field(const std::string& name, const std::vector<double>& values) override;
   std::array<double, kStageCount> stage_seconds() const override { return stage_s_; }
   std::array<long, kStageCount> stage_calls() const override { return stage_calls_; }

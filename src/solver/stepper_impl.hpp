@@ -1135,6 +1135,98 @@ io::Snapshot Stepper<D, Shape, Real>::snapshot(const std::vector<std::string>& f
   return s;
 }
 
+// A scatter of its own (the reference pointwise kernel, one thread) into
+// arrays of its own: between steps the solver's grid holds the last step's
+// values or, after MUSL's fused tail, the next step's P2G only on the nodes
+// that step will use, so it is not what the particles say now. Output only:
+// the cost is one serial P2G per snapshot.
+template <int D, class Shape, class Real>
+io::GridSnapshot Stepper<D, Shape, Real>::grid_snapshot(
+    const std::vector<std::string>& quantities) const {
+  io::GridSnapshot out;
+  if (quantities.empty()) return out;
+  for (int d = 0; d < D; ++d) {
+    out.nodes[std::size_t(d)] = G_.nodes_per_dim[std::size_t(d)];
+    out.origin[std::size_t(d)] = scene_.grid.origin[std::size_t(d)];
+    out.spacing[std::size_t(d)] = scene_.grid.cell[std::size_t(d)];
+  }
+  const std::size_t N = G_.nodes, F = std::size_t(plan_.fields);
+  std::vector<Real> m(N * F, Real(0));
+  std::array<std::vector<Real>, D> p, f;
+  GridView<D, Real> g;
+  g.nodes_per_dim = G_.nodes_per_dim;
+  g.h = G_.h;
+  g.origin = G_.origin;
+  g.nodes = N;
+  g.fields = plan_.fields;
+  g.m = m.data();
+  for (int d = 0; d < D; ++d) {
+    p[std::size_t(d)].assign(N * F, Real(0));
+    f[std::size_t(d)].assign(N * F, Real(0));
+    g.p[std::size_t(d)] = p[std::size_t(d)].data();
+    g.f[std::size_t(d)] = f[std::size_t(d)].data();
+  }
+  constexpr unsigned What = kMassMomentum | kForce;
+  const P2GOptions opt = p2g_options();
+  const bool multi = F > 1;
+  std::size_t bad = 0;
+  if (multi && has_traction_)
+    bad = p2g_range_pointwise<D, Shape, Real, What, true, true>(P_, g, opt, 0, P_.n);
+  else if (multi)
+    bad = p2g_range_pointwise<D, Shape, Real, What, true, false>(P_, g, opt, 0, P_.n);
+  else if (has_traction_)
+    bad = p2g_range_pointwise<D, Shape, Real, What, false, true>(P_, g, opt, 0, P_.n);
+  else
+    bad = p2g_range_pointwise<D, Shape, Real, What, false, false>(P_, g, opt, 0, P_.n);
+  if (bad != P_.n) fail_particle("output", bad, "its shape-function stencil left the grid");
+
+  // A field's name in dataset names: its material's, when it has one
+  // material with a plain name, else field<k>.
+  std::vector<std::string> label(F);
+  for (std::size_t k = 0; k < F; ++k) {
+    std::vector<std::size_t> of;
+    for (std::size_t mat = 0; mat < materials_.size(); ++mat)
+      if (std::size_t(plan_.field_of_material[mat]) == k) of.push_back(mat);
+    const std::string& name = of.size() == 1 ? materials_[of[0]].name : std::string();
+    const bool plain = !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
+      return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-';
+    });
+    label[k] = plain ? name : "field" + std::to_string(k);
+  }
+  // One quantity over the fields [k0, k1): the sum (velocity: of the
+  // momenta over the sum of the masses, 0 where that is a sliver).
+  auto quantity = [&](const std::string& q, std::size_t k0, std::size_t k1, std::string name) {
+    const int C = q == "mass" ? 1 : D;
+    io::ParticleField out_f{std::move(name), C, std::vector<double>(N * std::size_t(C), 0.0)};
+    for (std::size_t n = 0; n < N; ++n) {
+      double mass = 0, mom[3] = {0, 0, 0}, force[3] = {0, 0, 0};
+      for (std::size_t k = k0; k < k1; ++k) {
+        mass += double(m[k * N + n]);
+        for (int d = 0; d < D; ++d) {
+          mom[d] += double(p[std::size_t(d)][k * N + n]);
+          force[d] += double(f[std::size_t(d)][k * N + n]);
+        }
+      }
+      double* v = &out_f.values[n * std::size_t(C)];
+      if (q == "mass") {
+        v[0] = mass;
+      } else {
+        const bool heavy = mass > double(mass_threshold_);
+        for (int d = 0; d < D; ++d)
+          v[d] = q == "momentum" ? mom[d] : q == "force" ? force[d] : (heavy ? mom[d] / mass : 0.0);
+      }
+    }
+    return out_f;
+  };
+  for (const std::string& q : quantities) {
+    out.fields.push_back(quantity(q, 0, F, q));
+    if (multi)
+      for (std::size_t k = 0; k < F; ++k)
+        out.fields.push_back(quantity(q, k, k + 1, q + "." + label[k]));
+  }
+  return out;
+}
+
 template <int D, class Shape, class Real>
 std::vector<io::Blob> Stepper<D, Shape, Real>::save_state() const {
   std::vector<io::Blob> out;
