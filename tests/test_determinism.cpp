@@ -36,6 +36,9 @@ struct RunResult {
   std::string instantiation;
   std::size_t particles = 0, nodes = 0;
   std::vector<std::vector<double>> fields;  // kFields order
+  // output.grid_fields at the end: a serial scatter, so equal bits need the
+  // particles in the same order with either thread count
+  std::vector<mmpm::io::ParticleField> grid;
   std::vector<double> initial_position;
   Energies energies;
   StepCounters counters;
@@ -59,6 +62,17 @@ std::vector<double> velocity_field(const std::vector<double>& x, int dim, double
   return v;
 }
 
+// What a run leaves, recorded after its last step.
+void record_end(const Simulation& sim, RunResult& r) {
+  for (const char* f : kFields) r.fields.push_back(sim.particle_field(f).values);
+  r.grid = sim.grid_snapshot({"mass", "momentum", "velocity", "force"}).fields;
+  r.energies = sim.energies();
+  r.counters = sim.counters();
+  r.reactions = sim.reactions();
+  r.time = sim.time();
+  r.steps = sim.step_count();
+}
+
 RunResult run(const std::string& text, int threads, double drift) {
   omp_set_num_threads(threads);
   EXPECT_EQ(omp_get_max_threads(), threads);
@@ -72,12 +86,7 @@ RunResult run(const std::string& text, int threads, double drift) {
   r.initial_position = sim->particle_field("position").values;
   sim->set_particle_field("velocity", velocity_field(r.initial_position, dim, drift));
   for (int s = 0; s < kSteps; ++s) sim->step();
-  for (const char* f : kFields) r.fields.push_back(sim->particle_field(f).values);
-  r.energies = sim->energies();
-  r.counters = sim->counters();
-  r.reactions = sim->reactions();
-  r.time = sim->time();
-  r.steps = sim->step_count();
+  record_end(*sim, r);
   return r;
 }
 
@@ -101,6 +110,16 @@ void expect_identical(const RunResult& a, const RunResult& b) {
     EXPECT_EQ(count, 0u) << kFields[f] << ": " << count << " values differ, first at " << first
                          << ": " << (first < u.size() ? u[first] : 0.0) << " (1 thread) vs "
                          << (first < u.size() ? v[first] : 0.0) << " (2 threads)";
+  }
+  ASSERT_EQ(a.grid.size(), b.grid.size());
+  EXPECT_GE(a.grid.size(), 4u);
+  for (std::size_t q = 0; q < a.grid.size(); ++q) {
+    ASSERT_EQ(a.grid[q].name, b.grid[q].name);
+    ASSERT_EQ(a.grid[q].values.size(), b.grid[q].values.size()) << a.grid[q].name;
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < a.grid[q].values.size(); ++i)
+      differ += same_bits(a.grid[q].values[i], b.grid[q].values[i]) ? 0 : 1;
+    EXPECT_EQ(differ, 0u) << "grid " << a.grid[q].name;
   }
   const Energies& e = a.energies;
   const Energies& g = b.energies;
@@ -260,12 +279,7 @@ TEST(Determinism, FrictionContactTwoBlocksApproaching2D) {
     r.nodes = sim->node_count();
     r.initial_position = sim->particle_field("position").values;
     for (int k = 0; k < kSteps; ++k) sim->step();
-    for (const char* f : kFields) r.fields.push_back(sim->particle_field(f).values);
-    r.energies = sim->energies();
-    r.counters = sim->counters();
-    r.reactions = sim->reactions();
-    r.time = sim->time();
-    r.steps = sim->step_count();
+    record_end(*sim, r);
     return r;
   };
   const RunResult one = run_contact(1), two = run_contact(2);
