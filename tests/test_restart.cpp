@@ -311,6 +311,29 @@ TEST(Restart, KilledRunContinuesBitwise) {
   check_killed_run_continues_bitwise(kScene);
 }
 
+// A run stopped before its end (a full disk, a signal) looks unfinished,
+// has a checkpoint from part-way through, and `--restart` then ends with
+// the uninterrupted run's results, bitwise.
+void expect_stopped_then_restarts_bitwise(const fs::path& dir, const fs::path& ref_dir,
+                                          const json& ref_summary) {
+  EXPECT_FALSE(fs::exists(dir / "run.h5")) << "a stopped run must not look finished";
+  EXPECT_FALSE(fs::exists(dir / "summary.json")) << "a stopped run must not look finished";
+  ASSERT_TRUE(fs::exists(dir / "checkpoint.bin"));
+  const auto blobs = mmpm::io::read_checkpoint(dir / "checkpoint.bin");
+  const long ckpt_step = mmpm::io::read_scalar_blob<long>(mmpm::io::find_blob(blobs, "step"));
+  EXPECT_GT(ckpt_step, 0);
+  EXPECT_LT(ckpt_step, ref_summary.at("steps").get<long>());
+
+  const CmdResult again = run_mmpm({"run", "--restart", dir.string(), "--threads", "1", "--quiet"});
+  ASSERT_EQ(again.exit_code, 0) << again.describe();
+  expect_same_run(read_run(ref_dir / "run.h5"), read_run(dir / "run.h5"));
+  const json got = json::parse(read_text(dir / "summary.json"));
+  EXPECT_EQ(got.at("steps"), ref_summary.at("steps"));
+  for (const char* e : {"kinetic", "strain", "interface", "external_work", "damping"})
+    EXPECT_EQ(got.at("energy").at(e).get<double>(), ref_summary.at("energy").at(e).get<double>())
+        << e;
+}
+
 // A run whose output cannot grow (a full disk; here a file size limit,
 // `ulimit -f`, with SIGXFSZ ignored so that the write fails with EFBIG as
 // it does with ENOSPC) stops with exit 3 and one line naming the file and
@@ -338,22 +361,7 @@ TEST(Restart, RunStoppedByAFullDiskContinuesBitwise) {
   ASSERT_EQ(lines_of(full.err).size(), 1u) << full.describe();
   EXPECT_TRUE(contains(full.err, "run.h5.partial")) << full.err;
   EXPECT_TRUE(contains(full.err, "File too large")) << full.err;
-  EXPECT_FALSE(fs::exists(dir / "run.h5")) << "a failed run must not look finished";
-  EXPECT_FALSE(fs::exists(dir / "summary.json")) << "a failed run must not look finished";
-  ASSERT_TRUE(fs::exists(dir / "checkpoint.bin"));
-  const auto blobs = mmpm::io::read_checkpoint(dir / "checkpoint.bin");
-  const long ckpt_step = mmpm::io::read_scalar_blob<long>(mmpm::io::find_blob(blobs, "step"));
-  EXPECT_GT(ckpt_step, 0);
-  EXPECT_LT(ckpt_step, ref_summary.at("steps").get<long>());
-
-  const CmdResult again = run_mmpm({"run", "--restart", dir.string(), "--threads", "1", "--quiet"});
-  ASSERT_EQ(again.exit_code, 0) << again.describe();
-  expect_same_run(read_run(ref_dir / "run.h5"), read_run(dir / "run.h5"));
-  const json got = json::parse(read_text(dir / "summary.json"));
-  EXPECT_EQ(got.at("steps"), ref_summary.at("steps"));
-  for (const char* e : {"kinetic", "strain", "interface", "external_work", "damping"})
-    EXPECT_EQ(got.at("energy").at(e).get<double>(), ref_summary.at("energy").at(e).get<double>())
-        << e;
+  expect_stopped_then_restarts_bitwise(dir, ref_dir, ref_summary);
 }
 
 // Ctrl-C or a batch system's SIGTERM (app/interrupt.hpp) stops the run
@@ -412,22 +420,7 @@ void check_interrupted_run_continues_bitwise(int sig, const char* name) {
   ASSERT_EQ(lines_of(err).size(), 1u) << err;
   EXPECT_TRUE(contains(err, std::string("interrupted by ") + name)) << err;
   EXPECT_TRUE(contains(err, "mmpm run --restart " + dir.string())) << err;
-  EXPECT_FALSE(fs::exists(dir / "run.h5")) << "a stopped run must not look finished";
-  EXPECT_FALSE(fs::exists(dir / "summary.json")) << "a stopped run must not look finished";
-  ASSERT_TRUE(fs::exists(dir / "checkpoint.bin"));
-  const auto blobs = mmpm::io::read_checkpoint(dir / "checkpoint.bin");
-  const long ckpt_step = mmpm::io::read_scalar_blob<long>(mmpm::io::find_blob(blobs, "step"));
-  EXPECT_GT(ckpt_step, 0);
-  EXPECT_LT(ckpt_step, ref_summary.at("steps").get<long>());
-
-  const CmdResult again = run_mmpm({"run", "--restart", dir.string(), "--threads", "1", "--quiet"});
-  ASSERT_EQ(again.exit_code, 0) << again.describe();
-  expect_same_run(read_run(ref_dir / "run.h5"), read_run(dir / "run.h5"));
-  const json got = json::parse(read_text(dir / "summary.json"));
-  EXPECT_EQ(got.at("steps"), ref_summary.at("steps"));
-  for (const char* e : {"kinetic", "strain", "interface", "external_work", "damping"})
-    EXPECT_EQ(got.at("energy").at(e).get<double>(), ref_summary.at("energy").at(e).get<double>())
-        << e;
+  expect_stopped_then_restarts_bitwise(dir, ref_dir, ref_summary);
 }
 
 TEST(Restart, SigtermStopsWithACheckpointAndContinuesBitwise) {

@@ -57,6 +57,21 @@ const char* kind_name(AttributeKind kind) {
   return "Matrix";
 }
 
+// An XDMF 3 document up to the opening of its one temporal collection.
+void open_collection(std::ostringstream& out, const char* name) {
+  out << "<?xml version=\"1.0\" ?>\n"
+      << "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n"
+      << "<Xdmf Version=\"3.0\">\n"
+      << "  <Domain>\n"
+      << "    <Grid Name=\"" << name << "\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+}
+
+void close_collection(std::ostringstream& out) {
+  out << "    </Grid>\n"
+      << "  </Domain>\n"
+      << "</Xdmf>\n";
+}
+
 // "<DataItem ...>" for a dataset of the given shape.
 void shaped_item(std::ostringstream& out, const std::string& indent,
                  const std::vector<std::size_t>& shape, const std::string& h5_file,
@@ -86,11 +101,7 @@ AttributeKind attribute_kind(int components, int dimension) {
 
 std::string xdmf_document(const std::string& h5_file, const std::vector<XdmfSnapshot>& snapshots) {
   std::ostringstream out;
-  out << "<?xml version=\"1.0\" ?>\n"
-      << "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n"
-      << "<Xdmf Version=\"3.0\">\n"
-      << "  <Domain>\n"
-      << "    <Grid Name=\"particles\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+  open_collection(out, "particles");
   for (const XdmfSnapshot& s : snapshots) {
     if (s.dimension != 2 && s.dimension != 3) {
       throw std::invalid_argument("xdmf: dimension must be 2 or 3");
@@ -116,20 +127,14 @@ std::string xdmf_document(const std::string& h5_file, const std::vector<XdmfSnap
     }
     out << "      </Grid>\n";
   }
-  out << "    </Grid>\n"
-      << "  </Domain>\n"
-      << "</Xdmf>\n";
+  close_collection(out);
   return out.str();
 }
 
 std::string xdmf_grid_document(const std::string& h5_file,
                                const std::vector<XdmfGridSnapshot>& snapshots) {
   std::ostringstream out;
-  out << "<?xml version=\"1.0\" ?>\n"
-      << "<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n"
-      << "<Xdmf Version=\"3.0\">\n"
-      << "  <Domain>\n"
-      << "    <Grid Name=\"grid\" GridType=\"Collection\" CollectionType=\"Temporal\">\n";
+  open_collection(out, "grid");
   for (const XdmfGridSnapshot& s : snapshots) {
     if (s.dimension != 2 && s.dimension != 3) {
       throw std::invalid_argument("xdmf: dimension must be 2 or 3");
@@ -164,9 +169,7 @@ std::string xdmf_grid_document(const std::string& h5_file,
     }
     out << "      </Grid>\n";
   }
-  out << "    </Grid>\n"
-      << "  </Domain>\n"
-      << "</Xdmf>\n";
+  close_collection(out);
   return out.str();
 }
 
