@@ -223,6 +223,35 @@ json reference_run(const fs::path& scene, const fs::path& dir, double* seconds) 
   return json::parse(read_text(dir / "summary.json"));
 }
 
+// Runs the scene into dir (logs: <logs>.out, <logs>.err) and sends `sig`
+// once dir/<ready> exists and `delay` seconds have passed. sent = false:
+// the run ended before that.
+struct SignalledRun {
+  bool sent = false;
+  CmdResult result;
+};
+
+SignalledRun signal_part_way(const fs::path& scene, const fs::path& dir, const fs::path& logs,
+                             const char* ready, double delay, int sig) {
+  Child child(
+      {mmpm_binary(), "run", scene.string(), "--out", dir.string(), "--threads", "1", "--quiet"},
+      logs.string() + ".out", logs.string() + ".err");
+  const auto t0 = std::chrono::steady_clock::now();
+  SignalledRun r;
+  while (!child.poll_done()) {
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (fs::exists(dir / ready) && elapsed >= delay) {
+      child.kill_and_wait(sig);
+      r.sent = true;
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  r.result = child.result();
+  return r;
+}
+
 void check_killed_run_continues_bitwise(const std::string& scene_text) {
   TempDir tmp;
   const fs::path scene = tmp / "restart_scene.toml";
@@ -242,22 +271,11 @@ void check_killed_run_continues_bitwise(const std::string& scene_text) {
   bool killed = false;
   for (double fraction : {0.4, 0.2, 0.08, 0.0}) {
     fs::remove_all(dir);
-    Child child(
-        {mmpm_binary(), "run", scene.string(), "--out", dir.string(), "--threads", "1", "--quiet"},
-        tmp / "killed.out", tmp / "killed.err");
-    const auto t0 = std::chrono::steady_clock::now();
-    while (!child.poll_done()) {
-      const double elapsed =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      if (fs::exists(dir / "checkpoint.bin") && elapsed >= fraction * ref_seconds) {
-        child.kill_and_wait(SIGKILL);
-        killed = child.result().signal == SIGKILL;
-        break;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(2));
-    }
+    const SignalledRun r = signal_part_way(scene, dir, tmp / "killed", "checkpoint.bin",
+                                           fraction * ref_seconds, SIGKILL);
+    killed = r.sent && r.result.signal == SIGKILL;
     if (killed) break;
-    ASSERT_EQ(child.result().exit_code, 0)
+    ASSERT_EQ(r.result.exit_code, 0)
         << "the run to be killed failed by itself: " << read_text(tmp / "killed.err");
   }
   ASSERT_TRUE(killed) << "could not kill the run before it finished";
@@ -389,31 +407,17 @@ void check_interrupted_run_continues_bitwise(int sig, const char* name) {
   bool stopped = false;
   for (double fraction : {0.33, 0.1, 0.0}) {
     fs::remove_all(dir);
-    Child child(
-        {mmpm_binary(), "run", scene.string(), "--out", dir.string(), "--threads", "1", "--quiet"},
-        tmp / "stopped.out", tmp / "stopped.err");
-    const auto t0 = std::chrono::steady_clock::now();
-    while (!child.poll_done()) {
-      const double elapsed =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      if (fs::exists(dir / "run.h5.partial") && elapsed >= fraction * ref_seconds) {
-        child.kill_and_wait(sig);
-        stopped = true;
-        break;
-      }
-      std::this_thread::sleep_for(std::chrono::milliseconds(2));
-    }
-    if (stopped) {
-      const CmdResult& r = child.result();
-      if (r.exit_code == 0 && fs::exists(dir / "summary.json")) {
-        stopped = false;  // the signal came after the last step: a finished run
-        continue;
-      }
-      EXPECT_EQ(r.signal, 0) << name << " killed the process";
-      EXPECT_EQ(r.exit_code, 128 + sig);
+    const SignalledRun r =
+        signal_part_way(scene, dir, tmp / "stopped", "run.h5.partial", fraction * ref_seconds, sig);
+    if (r.sent) {
+      // A signal after the last step finds a finished run: try earlier.
+      if (r.result.exit_code == 0 && fs::exists(dir / "summary.json")) continue;
+      EXPECT_EQ(r.result.signal, 0) << name << " killed the process";
+      EXPECT_EQ(r.result.exit_code, 128 + sig);
+      stopped = true;
       break;
     }
-    ASSERT_EQ(child.result().exit_code, 0) << read_text(tmp / "stopped.err");
+    ASSERT_EQ(r.result.exit_code, 0) << read_text(tmp / "stopped.err");
   }
   ASSERT_TRUE(stopped) << "could not stop the run before it finished";
   const std::string err = read_text(tmp / "stopped.err");

@@ -78,6 +78,26 @@ void check_name(const std::string& name, const char* what) {
   }
 }
 
+// Fields of `count` points (particles or nodes): plain distinct names, at
+// least one component, count x components values.
+void check_fields(const std::vector<ParticleField>& fields, std::size_t count,
+                  const std::string& where, const char* what) {
+  std::set<std::string> names;
+  for (const ParticleField& f : fields) {
+    check_name(f.name, what);
+    if (!names.insert(f.name).second)
+      throw std::invalid_argument(where + "field '" + f.name + "' given twice");
+    if (f.components < 1)
+      throw std::invalid_argument(where + "field '" + f.name + "' needs >= 1 component");
+    const std::size_t expected = count * static_cast<std::size_t>(f.components);
+    if (f.values.size() != expected) {
+      throw std::invalid_argument(where + "field '" + f.name + "' holds " +
+                                  std::to_string(f.values.size()) + " values, expected " +
+                                  std::to_string(expected));
+    }
+  }
+}
+
 void check_snapshot(const Snapshot& s) {
   const std::string where = "snapshot at step " + std::to_string(s.step) + ": ";
   if (s.step < 0 || s.step > max_step) {
@@ -91,22 +111,10 @@ void check_snapshot(const Snapshot& s) {
                                 " values, expected count x dimension = " +
                                 std::to_string(s.count * static_cast<std::size_t>(s.dimension)));
   }
-  std::set<std::string> names;
-  for (const ParticleField& f : s.fields) {
-    check_name(f.name, "particle field");
+  for (const ParticleField& f : s.fields)
     if (f.name == "position")
       throw std::invalid_argument(where + "a field may not be called 'position'");
-    if (!names.insert(f.name).second)
-      throw std::invalid_argument(where + "field '" + f.name + "' given twice");
-    if (f.components < 1)
-      throw std::invalid_argument(where + "field '" + f.name + "' needs >= 1 component");
-    const std::size_t expected = s.count * static_cast<std::size_t>(f.components);
-    if (f.values.size() != expected) {
-      throw std::invalid_argument(where + "field '" + f.name + "' holds " +
-                                  std::to_string(f.values.size()) + " values, expected " +
-                                  std::to_string(expected));
-    }
-  }
+  check_fields(s.fields, s.count, where, "particle field");
 }
 
 void check_grid(const Snapshot& s) {
@@ -118,16 +126,7 @@ void check_grid(const Snapshot& s) {
       throw std::invalid_argument(where + "node counts must be >= 1 (1 beyond the dimension)");
     nodes *= std::size_t(g.nodes[std::size_t(d)]);
   }
-  std::set<std::string> names;
-  for (const ParticleField& f : g.fields) {
-    check_name(f.name, "grid field");
-    if (!names.insert(f.name).second)
-      throw std::invalid_argument(where + "field '" + f.name + "' given twice");
-    if (f.components < 1 || f.values.size() != nodes * std::size_t(f.components))
-      throw std::invalid_argument(where + "field '" + f.name + "' holds " +
-                                  std::to_string(f.values.size()) + " values, expected nodes x " +
-                                  std::to_string(f.components));
-  }
+  check_fields(g.fields, nodes, where, "grid field");
 }
 
 std::vector<double> padded_to_3(const std::vector<double>& xy, std::size_t count) {
@@ -153,11 +152,46 @@ void remove_snapshot(h5::Group& root, const std::string& name) {
   }
 }
 
+// The 2D vector fields of a snapshot, padded with a zero third column
+// (xdmf.hpp: ParaView takes only 3-component data as vectors), in
+// support/<snapshot>/<field> shaped `shape`; nothing without such a field.
+void write_padded_vectors(h5::Group& root, const char* support_group, const std::string& snapshot,
+                          const std::vector<ParticleField>& fields, std::size_t count,
+                          const std::vector<hsize_t>& shape) {
+  bool any_vector = false;
+  for (const ParticleField& f : fields)
+    any_vector = any_vector || attribute_kind(f.components, 2) == AttributeKind::vector;
+  if (!any_vector) return;
+  h5::Group padded = root.require_group(support_group).create_group(snapshot);
+  for (const ParticleField& f : fields)
+    if (attribute_kind(f.components, 2) == AttributeKind::vector)
+      padded.write_doubles(f.name, padded_to_3(f.values, count), shape);
+}
+
 bool has_padded_copy(const h5::Group& root, const std::string& snapshot, const std::string& field,
-                     const char* support_group = xdmf_group) {
+                     const char* support_group) {
   if (!root.contains(support_group)) return false;
   const h5::Group support = root.open_group(support_group);
   return support.contains(snapshot) && support.open_group(snapshot).contains(field);
+}
+
+// How run.xdmf / run_grid.xdmf reference data_group/<snapshot>/<field>: a
+// 2D vector through its padded copy in support_group, or, without one, as
+// plain components.
+XdmfField xdmf_field(const h5::Group& root, const char* data_group, const char* support_group,
+                     const std::string& snapshot, const std::string& field, int components,
+                     int dimension) {
+  XdmfField f{field, attribute_kind(components, dimension), absolute({data_group, snapshot, field}),
+              components};
+  if (f.kind == AttributeKind::vector && dimension == 2) {
+    if (has_padded_copy(root, snapshot, field, support_group)) {
+      f.dataset = absolute({support_group, snapshot, field});
+      f.stored_components = 3;
+    } else {
+      f.kind = AttributeKind::matrix;  // still viewable, just not as arrows
+    }
+  }
+  return f;
 }
 
 // The HDF5 shape of a grid quantity: [nz,] ny, nx, components.
@@ -187,20 +221,13 @@ void write_grid_data(h5::Group& root, const Snapshot& s, const std::string& name
   for (const ParticleField& f : g.fields)
     group.write_doubles(f.name, f.values, grid_shape(g, s.dimension, f.components));
   if (s.dimension != 2) return;
-  bool any_vector = false;
-  for (const ParticleField& f : g.fields)
-    any_vector = any_vector || attribute_kind(f.components, 2) == AttributeKind::vector;
-  if (!any_vector) return;
   // Shaped [1, ny, nx, 3], the rank of the 3D structured grid run_grid.xdmf
   // describes: ParaView's XDMF reader selects vector data by the grid's
   // dimensions and failed on [ny, nx, 3] ("selection + offset not within
   // extent"; scalars read either way).
-  h5::Group padded = root.require_group(xdmf_grid_group).create_group(name);
   std::vector<hsize_t> shape = grid_shape(g, 2, 3);
   shape.insert(shape.begin(), 1);
-  for (const ParticleField& f : g.fields)
-    if (attribute_kind(f.components, 2) == AttributeKind::vector)
-      padded.write_doubles(f.name, padded_to_3(f.values, nodes), shape);
+  write_padded_vectors(root, xdmf_grid_group, name, g.fields, nodes, shape);
 }
 
 // What run_grid.xdmf must describe, read back from the file (after a
@@ -229,18 +256,8 @@ std::vector<XdmfGridSnapshot> describe_grid(const h5::Group& root) {
         throw std::runtime_error("run file: grid/" + name + "/" + field + " has the wrong rank");
       for (int d = 0; d < D; ++d)
         s.nodes[std::size_t(d)] = std::size_t(shape[std::size_t(D - 1 - d)]);
-      const int components = static_cast<int>(shape.back());
-      XdmfField f{field, attribute_kind(components, D), absolute({grid_group, name, field}),
-                  components};
-      if (f.kind == AttributeKind::vector && D == 2) {
-        if (has_padded_copy(root, name, field, xdmf_grid_group)) {
-          f.dataset = absolute({xdmf_grid_group, name, field});
-          f.stored_components = 3;
-        } else {
-          f.kind = AttributeKind::matrix;
-        }
-      }
-      s.fields.push_back(std::move(f));
+      s.fields.push_back(xdmf_field(root, grid_group, xdmf_grid_group, name, field,
+                                    static_cast<int>(shape.back()), D));
     }
     out.push_back(std::move(s));
   }
@@ -265,19 +282,7 @@ void write_snapshot_data(h5::Group& root, const Snapshot& s, const std::string& 
     std::iota(ids.begin(), ids.end(), std::int64_t{0});
     support.write_ints(vertices_name(s.count), ids, {n});
   }
-  if (s.dimension == 2) {
-    bool any_vector = false;
-    for (const ParticleField& f : s.fields) {
-      any_vector = any_vector || attribute_kind(f.components, 2) == AttributeKind::vector;
-    }
-    if (any_vector) {
-      h5::Group padded = support.create_group(name);
-      for (const ParticleField& f : s.fields) {
-        if (attribute_kind(f.components, 2) != AttributeKind::vector) continue;
-        padded.write_doubles(f.name, padded_to_3(f.values, s.count), {n, 3});
-      }
-    }
-  }
+  if (s.dimension == 2) write_padded_vectors(root, xdmf_group, name, s.fields, s.count, {n, 3});
 }
 
 // Reads back what run.xdmf must describe, from the file itself: after a
@@ -302,17 +307,8 @@ std::vector<XdmfSnapshot> describe(const h5::Group& root) {
       if (field == "position") continue;
       const std::vector<hsize_t> fshape = group.open_dataset(field).shape();
       const int components = fshape.size() == 2 ? static_cast<int>(fshape[1]) : 1;
-      XdmfField f{field, attribute_kind(components, s.dimension),
-                  absolute({particles_group, name, field}), components};
-      if (f.kind == AttributeKind::vector && s.dimension == 2) {
-        if (has_padded_copy(root, name, field)) {
-          f.dataset = absolute({xdmf_group, name, field});
-          f.stored_components = 3;
-        } else {
-          f.kind = AttributeKind::matrix;  // still viewable, just not as arrows
-        }
-      }
-      s.fields.push_back(std::move(f));
+      s.fields.push_back(
+          xdmf_field(root, particles_group, xdmf_group, name, field, components, s.dimension));
     }
     out.push_back(std::move(s));
   }

@@ -72,22 +72,23 @@ void close_collection(std::ostringstream& out) {
       << "</Xdmf>\n";
 }
 
-// "<DataItem ...>" for a dataset of the given shape.
-void shaped_item(std::ostringstream& out, const std::string& indent,
-                 const std::vector<std::size_t>& shape, const std::string& h5_file,
-                 const std::string& dataset) {
+// "<DataItem ...>" for an HDF5 dataset of the given shape (slowest first).
+void data_item(std::ostringstream& out, const std::string& indent,
+               const std::vector<std::size_t>& shape, const char* number_type,
+               const std::string& h5_file, const std::string& dataset) {
   out << indent << "<DataItem Dimensions=\"";
   for (std::size_t i = 0; i < shape.size(); ++i) out << (i ? " " : "") << shape[i];
-  out << "\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">" << escaped(h5_file) << ':'
-      << escaped(dataset) << "</DataItem>\n";
-}
-
-void data_item(std::ostringstream& out, const std::string& indent, std::size_t rows, int columns,
-               const char* number_type, const std::string& h5_file, const std::string& dataset) {
-  out << indent << "<DataItem Dimensions=\"" << rows;
-  if (columns > 0) out << ' ' << columns;
   out << "\" NumberType=\"" << number_type << "\" Precision=\"8\" Format=\"HDF\">"
       << escaped(h5_file) << ':' << escaped(dataset) << "</DataItem>\n";
+}
+
+// "<Attribute ...>" of one nodal field, its dataset shaped `shape`.
+void attribute(std::ostringstream& out, const std::string& indent, const XdmfField& f,
+               const std::vector<std::size_t>& shape, const std::string& h5_file) {
+  out << indent << "<Attribute Name=\"" << escaped(f.name) << "\" AttributeType=\""
+      << kind_name(f.kind) << "\" Center=\"Node\">\n";
+  data_item(out, indent + "  ", shape, "Float", h5_file, f.dataset);
+  out << indent << "</Attribute>\n";
 }
 
 }  // namespace
@@ -114,17 +115,13 @@ std::string xdmf_document(const std::string& h5_file, const std::vector<XdmfSnap
         // differ on what an implicit Polyvertex topology means.
         << in << "<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"" << s.count
         << "\" NodesPerElement=\"1\">\n";
-    data_item(out, in + "  ", s.count, 0, "Int", h5_file, s.connectivity);
+    data_item(out, in + "  ", {s.count}, "Int", h5_file, s.connectivity);
     out << in << "</Topology>\n"
         << in << "<Geometry GeometryType=\"" << (s.dimension == 2 ? "XY" : "XYZ") << "\">\n";
-    data_item(out, in + "  ", s.count, s.dimension, "Float", h5_file, s.position);
+    data_item(out, in + "  ", {s.count, std::size_t(s.dimension)}, "Float", h5_file, s.position);
     out << in << "</Geometry>\n";
-    for (const XdmfField& f : s.fields) {
-      out << in << "<Attribute Name=\"" << escaped(f.name) << "\" AttributeType=\""
-          << kind_name(f.kind) << "\" Center=\"Node\">\n";
-      data_item(out, in + "  ", s.count, f.stored_components, "Float", h5_file, f.dataset);
-      out << in << "</Attribute>\n";
-    }
+    for (const XdmfField& f : s.fields)
+      attribute(out, in, f, {s.count, std::size_t(f.stored_components)}, h5_file);
     out << "      </Grid>\n";
   }
   close_collection(out);
@@ -157,15 +154,12 @@ std::string xdmf_grid_document(const std::string& h5_file,
         << exact(s.spacing[0]) << "</DataItem>\n"
         << in << "</Geometry>\n";
     for (const XdmfField& f : s.fields) {
-      out << in << "<Attribute Name=\"" << escaped(f.name) << "\" AttributeType=\""
-          << kind_name(f.kind) << "\" Center=\"Node\">\n";
       std::vector<std::size_t> shape;
       // A 2D vector's padded copy has the 3D grid's rank (run_writer.cpp).
       if (s.dimension == 2 && f.kind == AttributeKind::vector) shape.push_back(1);
       for (int d = s.dimension - 1; d >= 0; --d) shape.push_back(s.nodes[std::size_t(d)]);
       shape.push_back(std::size_t(f.stored_components));
-      shaped_item(out, in + "  ", shape, h5_file, f.dataset);
-      out << in << "</Attribute>\n";
+      attribute(out, in, f, shape, h5_file);
     }
     out << "      </Grid>\n";
   }

@@ -163,8 +163,8 @@ std::vector<OpenContact> open_contacts(const Scene& scene, const FieldPlan& plan
 // The materials of a field, quoted and joined ("'a'", "'a' and 'b'").
 std::string materials_of(const Scene& scene, const FieldPlan& plan, int field) {
   std::vector<std::string> names;
-  for (std::size_t m = 0; m < scene.materials.size(); ++m)
-    if (plan.field_of_material[m] == field) names.push_back("'" + scene.materials[m].name + "'");
+  for (const std::size_t m : materials_in_field(plan, field))
+    names.push_back("'" + scene.materials[m].name + "'");
   std::string s;
   for (std::size_t i = 0; i < names.size(); ++i)
     s += (i == 0 ? "" : i + 1 == names.size() ? " and " : ", ") + names[i];

@@ -23,6 +23,15 @@ struct FieldPlan {
 
 FieldPlan plan_fields(const Scene& scene);
 
+// The materials (indices into scene.materials) whose particles move with
+// `field`, in scene order.
+inline std::vector<std::size_t> materials_in_field(const FieldPlan& plan, int field) {
+  std::vector<std::size_t> out;
+  for (std::size_t m = 0; m < plan.field_of_material.size(); ++m)
+    if (plan.field_of_material[m] == field) out.push_back(m);
+  return out;
+}
+
 // Whether some interaction computes its normal from the domain gradients
 // g_i (P-33: mvg, avg, rigid). Only then does P2G scatter g.
 inline bool needs_domain_gradient(const FieldPlan& plan) {

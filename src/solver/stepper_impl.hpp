@@ -1184,9 +1184,7 @@ io::GridSnapshot Stepper<D, Shape, Real>::grid_snapshot(
   // material with a plain name, else field<k>.
   std::vector<std::string> label(F);
   for (std::size_t k = 0; k < F; ++k) {
-    std::vector<std::size_t> of;
-    for (std::size_t mat = 0; mat < materials_.size(); ++mat)
-      if (std::size_t(plan_.field_of_material[mat]) == k) of.push_back(mat);
+    const std::vector<std::size_t> of = materials_in_field(plan_, int(k));
     const std::string& name = of.size() == 1 ? materials_[of[0]].name : std::string();
     const bool plain = !name.empty() && std::all_of(name.begin(), name.end(), [](char c) {
       return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-';
