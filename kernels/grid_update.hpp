@@ -30,6 +30,36 @@ struct GridUpdateParams {
   // same pass: for steps where nothing changes p in between (no
   // multimaterial pass B). Bitwise the two separate passes.
   bool velocities = false;
+  // USL only (0 otherwise): at nodes whose mass is at most this, vel leaves
+  // out the force increment (light_node_velocity below).
+  double light_threshold = 0;
+};
+
+// USL's velocity gradient reads the grid velocity after the momentum
+// update, v = (p + dt (f + m g - alpha p)) / m. At a node that a particle
+// barely reaches, m ~ S m_p while the force f, made of the weight gradient
+// G, does not vanish with S (G ~ sqrt(S) at a uGIMP support edge, 1/h for
+// linear shapes): the particle's strain rate takes G dt f / m, which grows
+// without bound as S -> 0 (USL's small-mass instability). The two-layer
+// scene in float went unstable this way (J <= 0 at step 202 and, with that
+// node alone fixed, at step 303). MUSL and USF read p / m of extrapolated
+// momenta (weighted means of particle velocities) and have no such term.
+// So at a light node USL's gradient and positions use the velocity without
+// the force increment, v_old + dt (g - alpha v_old) (gravity and damping
+// stay: they are per unit mass, bounded); the FLIP increment dvel, which
+// the particles take scaled by S, keeps the force. docs/validation.md §3.5.
+template <class Real>
+[[gnu::always_inline]] inline Real light_node_velocity(Real v_old, Real dt, Real alpha, Real g) {
+  return std::fma(dt, std::fma(-alpha, v_old, g), v_old);
+}
+
+// USL's light nodes for grid_velocities: threshold 0 (MUSL, USF): none.
+template <int D, class Real>
+struct LightNodes {
+  Real threshold = 0;  // a node of mass <= threshold (and above the sliver threshold) is light
+  Real dt = 0, alpha = 0;
+  Real gacc[D] = {};
+  const unsigned char* rigid = nullptr;  // per field: prescribed velocities are left alone
 };
 
 namespace detail {
@@ -49,7 +79,7 @@ namespace detail {
 template <int D, class Real, bool Interface, bool Damping, bool Velocities>
 [[gnu::noinline]] void update_deformable(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
                                          std::size_t o, std::size_t b, std::size_t e, Real dt,
-                                         Real alpha, Real thr, const Real (&gacc)[D],
+                                         Real alpha, Real thr, Real light, const Real (&gacc)[D],
                                          double* __restrict pv) {
   const Real* __restrict m_ = G.m + o;
   Real* __restrict p_[D];
@@ -76,6 +106,10 @@ template <int D, class Real, bool Interface, bool Damping, bool Velocities>
     const bool some = m > Real(0);
     const Real inv_m = Real(1) / m;
     double sum = 0;
+    // Unrolled completely: with USL's light-node select the body grew past
+    // GCC's complete-unroll limit in 3D, the n loop then held a loop over d,
+    // and it stayed scalar (tools/check_vectorised.py).
+#pragma GCC unroll 3
     for (int d = 0; d < D; ++d) {
       const Real p = p_[d][n];
       // The per-node formulas (§2) with every multiply-add an explicit fma:
@@ -90,7 +124,9 @@ template <int D, class Real, bool Interface, bool Damping, bool Velocities>
       const Real updated = std::fma(dt, damped, p);
       if constexpr (Velocities) {
         // grid_velocities' formulas on the updated momentum.
-        vel_[d][n] = heavy ? updated * inv_m : Real(0);
+        const Real v_old = p * inv_m;
+        const Real v_light = light_node_velocity(v_old, dt, alpha, gacc[d]);
+        vel_[d][n] = heavy ? (m <= light ? v_light : updated * inv_m) : Real(0);
         dv_[d][n] = heavy ? std::fma(updated, inv_m, -p * inv_m) : sliver;
       } else {
         dv_[d][n] = heavy ? -p * inv_m : sliver;
@@ -113,7 +149,8 @@ template <int D, class Real, bool Interface, bool Damping, bool Velocities>
 template <int D, class Real, class After = NoNodeHook>
 double grid_update(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
                    const GridUpdateParams& q, const NodeOwnership& own = {}, After&& after = {}) {
-  const Real dt = Real(q.dt), alpha = Real(q.damping), thr = Real(q.mass_threshold);
+  const Real dt = Real(q.dt), alpha = Real(q.damping), thr = Real(q.mass_threshold),
+             light = Real(q.light_threshold);
   auto body = [&](int f, std::size_t b, std::size_t e, std::array<double, 1>& acc) {
     const std::size_t o = std::size_t(f) * G.nodes;
     if (q.rigid && q.rigid[f]) {
@@ -148,9 +185,11 @@ double grid_update(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
     const bool damping = q.damping != 0;
     auto run = [&]<bool I, bool Dmp>() {
       if (q.velocities)
-        detail::update_deformable<D, Real, I, Dmp, true>(G, V, o, b, e, dt, alpha, thr, gacc, pv);
+        detail::update_deformable<D, Real, I, Dmp, true>(G, V, o, b, e, dt, alpha, thr, light, gacc,
+                                                         pv);
       else
-        detail::update_deformable<D, Real, I, Dmp, false>(G, V, o, b, e, dt, alpha, thr, gacc, pv);
+        detail::update_deformable<D, Real, I, Dmp, false>(G, V, o, b, e, dt, alpha, thr, light,
+                                                          gacc, pv);
     };
     if (q.has_interface_force)
       damping ? run.template operator()<true, true>() : run.template operator()<true, false>();
@@ -193,10 +232,17 @@ namespace detail {
 // the select drops).
 template <bool CompleteDvel, int D, class Real, class After>
 void node_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V, Real thr,
-                     const NodeOwnership& own, After& after) {
+                     const LightNodes<D, Real>& ln, const NodeOwnership& own, After& after) {
 #pragma omp parallel if (G.nodes * std::size_t(G.fields) >= kParallelMin)
   for_own_field_nodes(own, G.nodes, G.fields, [&](int f, std::size_t first, std::size_t last) {
     const std::size_t o = std::size_t(f) * G.nodes;
+    // Locals, not reads through `ln` in the loop: the stores to vel_ and
+    // dv_ could alias them, and the loop then stayed scalar
+    // (tools/check_vectorised.py).
+    const Real light = ln.rigid && ln.rigid[f] ? Real(0) : ln.threshold;
+    const Real light_dt = ln.dt, light_alpha = ln.alpha;
+    Real light_g[D];
+    for (int d = 0; d < D; ++d) light_g[d] = ln.gacc[d];
     const Real* __restrict m_ = G.m;
     const Real* __restrict p_[D];
     Real* __restrict vel_[D];
@@ -210,8 +256,10 @@ void node_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
         const Real inv_m = Real(1) / m;
         for (int d = 0; d < D; ++d) {
           // dvel + p/m as an explicit fma (see update_deformable).
+          // dv_ holds -v_old (grid_update).
           const Real v = p_[d][i] * inv_m, dv = std::fma(p_[d][i], inv_m, dv_[d][i]);
-          vel_[d][i] = heavy ? v : Real(0);
+          const Real v_light = light_node_velocity(-dv_[d][i], light_dt, light_alpha, light_g[d]);
+          vel_[d][i] = heavy ? (m <= light ? v_light : v) : Real(0);
           dv_[d][i] = heavy ? dv : dv_[d][i];  // slivers: set by grid_update
         }
       } else {
@@ -229,11 +277,13 @@ void node_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
 
 // vel = p/m, dvel += vel (completing v_new - v_old), after pass B; nodes
 // with a sliver of mass keep vel = 0 and the increment grid_update gave them.
-// Then after(f, first, last) on each range, as grid_update.
+// Then after(f, first, last) on each range, as grid_update. `light`: USL's
+// light nodes (light_node_velocity).
 template <int D, class Real, class After = NoNodeHook>
 void grid_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V, Real thr,
-                     const NodeOwnership& own = {}, After&& after = {}) {
-  detail::node_velocities<true>(G, V, thr, own, after);
+                     const NodeOwnership& own = {}, After&& after = {},
+                     const LightNodes<D, Real>& light = {}) {
+  detail::node_velocities<true>(G, V, thr, light, own, after);
 }
 
 // vel = p/m alone (dvel untouched): the velocities of re-extrapolated
@@ -244,7 +294,7 @@ void grid_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
 template <int D, class Real, class After = NoNodeHook>
 void grid_momentum_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V, Real thr,
                               const NodeOwnership& own = {}, After&& after = {}) {
-  detail::node_velocities<false>(G, V, thr, own, after);
+  detail::node_velocities<false>(G, V, thr, LightNodes<D, Real>{}, own, after);
 }
 
 }  // namespace mmpm

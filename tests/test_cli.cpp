@@ -577,6 +577,39 @@ particles_per_cell = 2
   EXPECT_TRUE(contains(one_lines[0], "'strip' and 'block_b'")) << one_lines[0];
 }
 
+// scheme = "USL" is stable to about cfl = 0.75 (docs/validation.md §3.5:
+// 2D and 3D bars run at 0.75 and blow up at 0.78-0.8): check and run warn
+// above it, once, at the key that set the step, and still run (run refuses
+// only cfl > 1). MUSL at the same cfl, and USL below the limit, say nothing.
+TEST(Cli, UslAboveItsLimitWarns) {
+  const std::string usl = "simulation.scheme=\"USL\"";
+  for (const char* command : {"check", "run"}) {
+    TempDir tmp;
+    std::vector<std::string> args = {
+        command, bar_scene(),          "--set", usl,
+        "--set", "simulation.cfl=0.9", "--set", "simulation.end_time=0.002"};
+    if (std::string(command) == "run") args.insert(args.end(), {"--out", (tmp / "o").string()});
+    const CmdResult fast = run_mmpm(args);
+    ASSERT_EQ(fast.exit_code, 0) << fast.describe();
+    const auto lines = lines_of(fast.err);
+    ASSERT_EQ(lines.size(), 1u) << fast.describe();
+    EXPECT_TRUE(contains(lines[0], bar_scene() + ": warning: key 'simulation.cfl': scheme \"USL\" "
+                                                 "is stable only to about cfl = 0.75 (measured)"))
+        << lines[0];
+    EXPECT_TRUE(contains(lines[0], "this step is cfl 0.9")) << lines[0];
+  }
+  for (const std::vector<std::string>& sets :
+       {std::vector<std::string>{"--set", usl, "--set", "simulation.cfl=0.75"},
+        std::vector<std::string>{"--set", "simulation.scheme=\"MUSL\"", "--set",
+                                 "simulation.cfl=0.9"}}) {
+    std::vector<std::string> args = {"check", bar_scene()};
+    args.insert(args.end(), sets.begin(), sets.end());
+    const CmdResult quiet = run_mmpm(args);
+    ASSERT_EQ(quiet.exit_code, 0) << quiet.describe();
+    EXPECT_TRUE(quiet.err.empty()) << quiet.describe();
+  }
+}
+
 // The kinetic-ratio stop waits until the scene no longer drives the bodies
 // (run_driver.cpp still_driven): inputs/gripped_bar.toml, whose rigid grip
 // pulls the bar until 0.1 ms. With kinetic_ratio = 0.1, a threshold the

@@ -32,6 +32,7 @@ int check_scene(const std::string& file, const std::vector<std::string>& sets) {
     std::cerr
         << file << ": warning: key 'simulation." << (scene.simulation.dt ? "dt" : "cfl")
         << "': the time step exceeds the stability limit; `mmpm run` refuses it unless --force\n";
+  if (const std::string w = usl_time_step_warning(scene, dt); !w.empty()) std::cerr << w << "\n";
   for (const std::string& w : open_contact_warnings(scene, *sim)) std::cerr << w << "\n";
   return 0;
 }

@@ -228,8 +228,10 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
   }
   check_step_count(scene, dt);
   std::unique_ptr<Simulation> sim = make_simulation(scene);
-  if (!resume && opt.warnings)
+  if (!resume && opt.warnings) {
+    if (const std::string w = usl_time_step_warning(scene, dt); !w.empty()) std::cerr << w << "\n";
     for (const std::string& w : open_contact_warnings(scene, *sim)) std::cerr << w << "\n";
+  }
   const int dim = scene.simulation.dimension;
   DriverState st;
   st.names = series_names(*sim);

@@ -105,6 +105,9 @@ std::unique_ptr<Simulation> make_simulation(const Scene& scene);
 double stable_time_step(const Scene& scene);
 double critical_time_step(const Scene& scene);  // the same with cfl = 1
 double damping_time_step(const Scene& scene);   // 2 / grid.damping (its own limit)
+// `run` and `check`: a warning (one line, empty if none) when scheme = "USL"
+// takes a step above its own limit, about cfl = 1 / sqrt(dimension).
+std::string usl_time_step_warning(const Scene& scene, double dt);
 // `run` and `check`: an end_time / dt beyond any run (1e12 steps) is bad
 // input. (The library steps on past end_time for as long as it is asked.)
 void check_step_count(const Scene& scene, double dt);

@@ -156,6 +156,7 @@ class Stepper final : public Simulation {
   void grid_update_stage();
   void update_node_ownership(bool rebuilt);
   void update_active_nodes();
+  Real usl_light_threshold() const;
   void finish_velocities(bool with_dvel);
   Supports<Real> supports(bool with_dvel);
   void add_rigid_work();

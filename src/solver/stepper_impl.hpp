@@ -686,6 +686,7 @@ void Stepper<D, Shape, Real>::grid_update_stage() {
   q.rigid = plan_.rigid.data();
   q.rigid_velocity = reinterpret_cast<const double(*)[3]>(rigid_velocity_now_.data());
   q.has_interface_force = mm_.has_interface_forces();
+  q.light_threshold = double(usl_light_threshold());
   // Without pass B nothing changes p before the velocities: one pass, which
   // also applies the supports.
   q.velocities = !plan_.multimaterial;
@@ -751,12 +752,28 @@ void Stepper<D, Shape, Real>::add_rigid_work() {
   }
 }
 
+// USL's light nodes (kernels/grid_update.hpp, light_node_velocity): a mass
+// of at most 1e-6 of the lightest particle, the threshold below which the
+// multimaterial pass already takes a field as empty (ALGORITHM §4.3); 0
+// (none) in MUSL and USF.
+template <int D, class Shape, class Real>
+Real Stepper<D, Shape, Real>::usl_light_threshold() const {
+  if (scene_.simulation.scheme != Scheme::USL) return Real(0);
+  return Real(min_particle_mass_) * Real(1e-6);  // as MultimaterialStage::setup
+}
+
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::finish_velocities(bool with_dvel) {
   const Supports<Real> s = supports(with_dvel);
   auto hook = [&](int f, std::size_t b, std::size_t e) { apply_supports(G_, GV_, s, f, b, e); };
   if (with_dvel) {
-    grid_velocities(G_, GV_, mass_threshold_, own_, hook);
+    LightNodes<D, Real> light;
+    light.threshold = usl_light_threshold();
+    light.dt = Real(dt_);
+    light.alpha = Real(scene_.grid.damping);
+    for (int d = 0; d < D; ++d) light.gacc[d] = Real(gravity_[d]);
+    light.rigid = plan_.rigid.data();
+    grid_velocities(G_, GV_, mass_threshold_, own_, hook, light);
     collect_support_reactions();
   } else {
     grid_momentum_velocities(G_, GV_, mass_threshold_, own_, hook);

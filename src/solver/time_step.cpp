@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <limits>
 #include <sstream>
 #include <string>
@@ -57,6 +58,34 @@ double critical_time_step(const Scene& scene) {
   const double speed = fastest_wave(scene).speed + fastest_motion(scene).speed;
   const double wave = speed > 0 ? hmin / speed : scene.simulation.end_time;
   return std::min(wave, damping_time_step(scene));
+}
+
+// USL computes the strains from the grid velocity after the momentum
+// update (symplectic Euler on the grid): the fastest grid mode, which
+// couples the directions, bounds its step below the wave-crossing time
+// that `cfl` counts. MUSL and USF read velocities re-extrapolated from the
+// particles, which damp that mode, and run to cfl = 1. Measured for 2 ms on
+// bars of 25 x 1 (x 1) mm, h = 0.5 mm, nu = 0 (docs/validation.md §3.5):
+// USL stable at cfl 0.75 in 2D (uGIMP, linear) and 3D (uGIMP), unstable at
+// 0.78 (2D uGIMP, step 412) and 0.8 (2D linear, 3D uGIMP); MUSL and USF
+// stable at 1.0. A warning, not a refusal: the limit is a measurement, and
+// a scene that ends within a few wave passes may finish before the mode
+// grows.
+constexpr double kUslCflLimit = 0.75;
+
+std::string usl_time_step_warning(const Scene& scene, double dt) {
+  if (scene.simulation.scheme != Scheme::USL) return {};
+  const double limit = kUslCflLimit;
+  const double cfl = dt / critical_time_step(scene);
+  if (!(cfl > limit * (1 + 1e-12))) return {};
+  const Where& w = scene.simulation.step_where;
+  std::ostringstream m;
+  m << scene.source_file << ": warning: key '" << (w.key.empty() ? "simulation.cfl" : w.key)
+    << "': scheme \"USL\" is "
+    << "stable only to about cfl = " << limit << " (measured); this step is cfl "
+    << std::setprecision(3) << cfl
+    << ". Use a smaller step, or scheme \"MUSL\" (stable to cfl = 1)";
+  return m.str();
 }
 
 // Grid damping p <- p + dt (f - alpha p) multiplies a free node's momentum
