@@ -60,6 +60,17 @@ struct LightNodes {
   Real dt = 0, alpha = 0;
   Real gacc[D] = {};
   const unsigned char* rigid = nullptr;  // per field: prescribed velocities are left alone
+
+  // The same light nodes as grid_update's with these parameters.
+  static LightNodes of(const GridUpdateParams& q) {
+    LightNodes l;
+    l.threshold = Real(q.light_threshold);
+    l.dt = Real(q.dt);
+    l.alpha = Real(q.damping);
+    for (int d = 0; d < D; ++d) l.gacc[d] = Real(q.body_accel[d]);
+    l.rigid = q.rigid;
+    return l;
+  }
 };
 
 namespace detail {

@@ -11,6 +11,8 @@
 // reads g through kDomainGradientOutward, the one place to change if P2G stores +∇Ω.
 #pragma once
 
+#include <limits>
+
 #include "kernels/mm_common.hpp"
 
 namespace mmpm {
@@ -64,6 +66,21 @@ VecD<D, Real> normal_radial(const std::array<Real, 3>& node_position,
   VecD<D, Real> n;
   for (int d = 0; d < D; ++d) n[d] = sign * (node_position[d] - center[d]);
   return mm_detail::normalized_or_zero<D, Real>(n);
+}
+
+// The squared tangential opening |δ − (δ·n)n|² (P-15) when it is an opening, 0 when
+// it is only the rounding left by the subtraction (δ along n to within 1024 ε |δ|).
+// Such a remainder points anywhere, along n too; then t ∥ n, s = n × t vanishes
+// and so does the 3D h⊥ (§4.2), and the contact area (P-20) divides by it. In
+// sphere_in_cube (radial normal, radial opening) one node's area came out 2e14
+// instead of 0.01: an interface force 16 orders too large, which made every
+// force_limit = false run unstable within 6 steps, even at Dn = Dt = 1e-3, and
+// turned the node to stick with the limit on (docs/multimaterial.md §3.2).
+// Compared as squares: no square root for the test.
+template <class Real>
+inline Real resolved_opening_squared(Real opening_t2, Real delta2) {
+  constexpr Real tol = Real(1024) * std::numeric_limits<Real>::epsilon();
+  return opening_t2 > tol * tol * delta2 ? opening_t2 : Real(0);
 }
 
 // A unit tangent for the interface: along the tangential opening δ − (δ·n)n when it is

@@ -231,7 +231,8 @@ template <NormalMethod M, Law L, bool UseDf, int D, class Real>
     for (int d = 0; d < D; ++d) delta[d] = B.mx[1][d][i] * inv_mb - B.mx[0][d][i] * inv_ma;
     const Real delta_n = dot<D, Real>(delta, n);
     const VecD<D, Real> opening_t = add_scaled<D, Real>(delta, n, -delta_n);
-    const Real delta_t = std::sqrt(dot<D, Real>(opening_t, opening_t));
+    const Real delta_t = std::sqrt(
+        resolved_opening_squared(dot<D, Real>(opening_t, opening_t), dot<D, Real>(delta, delta)));
     VecD<D, Real> t;
     {
       const Real inv_len = Real(1) / delta_t;

@@ -286,7 +286,8 @@ PairGeometry<D, Real> pair_geometry(const MaterialSide<D, Real>& a, const Materi
   for (int d = 0; d < D; ++d) delta[d] = b.mx[d] * inv_mb - a.mx[d] * inv_ma;
   G.delta_n = dot<D, Real>(delta, G.n);
   const VecD<D, Real> opening_t = add_scaled<D, Real>(delta, G.n, -G.delta_n);  // (P-15)
-  G.delta_t = std::sqrt(dot<D, Real>(opening_t, opening_t));
+  G.delta_t = std::sqrt(
+      resolved_opening_squared(dot<D, Real>(opening_t, opening_t), dot<D, Real>(delta, delta)));
   G.t = tangent_or_perpendicular<D, Real>(opening_t, G.delta_t, G.n);
   G.h_perp = mmpm::h_perp<D, Real>(G.n, G.t, h);
   G.valid = true;

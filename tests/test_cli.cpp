@@ -610,6 +610,48 @@ TEST(Cli, UslAboveItsLimitWarns) {
   }
 }
 
+// An interface with force_limit = false too stiff for the step
+// (docs/multimaterial.md §8: omega dt > 2 at a node the interface halves)
+// is named at its [[interaction]] line and key by `check` and `run`, once.
+// two_layer.toml: bound Dn = 4.3e4 MPa/mm; 6e4 gives omega dt = 2.36 (it
+// goes unstable at step 86; these runs stop after 24 steps). No warning
+// with the limit on, below the bound, with the exact integration, or for a
+// perfect direction.
+TEST(Cli, StiffInterfaceWithoutForceLimitWarns) {
+  const std::string scene = source_dir() + "/inputs/two_layer.toml";
+  const std::vector<std::string> stiff = {"--set", "interaction[0].Dn=6e4", "--set",
+                                          "interaction[0].force_limit=false"};
+  for (const char* command : {"check", "run"}) {
+    TempDir tmp;
+    std::vector<std::string> args = {command, scene, "--set", "simulation.end_time=0.002"};
+    args.insert(args.end(), stiff.begin(), stiff.end());
+    if (std::string(command) == "run") args.insert(args.end(), {"--out", (tmp / "o").string()});
+    const CmdResult r = run_mmpm(args);
+    ASSERT_EQ(r.exit_code, 0) << r.describe();
+    const auto lines = lines_of(r.err);
+    ASSERT_EQ(lines.size(), 1u) << r.describe();
+    EXPECT_TRUE(contains(lines[0], scene + ":51: warning: key 'interaction[0].Dn': with "
+                                           "force_limit = false, Dn = 6e+04 is stiffer"))
+        << lines[0];
+    EXPECT_TRUE(contains(lines[0], "omega dt = 2.36")) << lines[0];
+    EXPECT_TRUE(contains(lines[0], "Dn below about 4.31e+04")) << lines[0];
+  }
+  for (const std::vector<std::string>& sets :
+       {std::vector<std::string>{"--set", "interaction[0].Dn=6e4"},
+        std::vector<std::string>{"--set", "interaction[0].Dn=3e4", "--set",
+                                 "interaction[0].force_limit=false"},
+        std::vector<std::string>{"--set", "interaction[0].Dn=6e4", "--set",
+                                 "interaction[0].force_limit=false", "--set",
+                                 "interaction[0].integration=\"exact\""},
+        std::vector<std::string>{"--set", "interaction[0].force_limit=false"}}) {
+    std::vector<std::string> args = {"check", scene};
+    args.insert(args.end(), sets.begin(), sets.end());
+    const CmdResult quiet = run_mmpm(args);
+    ASSERT_EQ(quiet.exit_code, 0) << quiet.describe();
+    EXPECT_TRUE(quiet.err.empty()) << quiet.describe();
+  }
+}
+
 // The kinetic-ratio stop waits until the scene no longer drives the bodies
 // (run_driver.cpp still_driven): inputs/gripped_bar.toml, whose rigid grip
 // pulls the bar until 0.1 ms. With kinetic_ratio = 0.1, a threshold the

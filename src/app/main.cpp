@@ -6,11 +6,11 @@
 #include "app/build_info.hpp"
 #include "app/interrupt.hpp"
 #include "app/run_driver.hpp"
+#include "app/start_warnings.hpp"
 #include "app/sweep.hpp"
 #include "scene/error.hpp"
 #include "scene/format.hpp"
 #include "scene/parse.hpp"
-#include "solver/contact_gap.hpp"
 #include "solver/simulation.hpp"
 
 namespace {
@@ -32,8 +32,7 @@ int check_scene(const std::string& file, const std::vector<std::string>& sets) {
     std::cerr
         << file << ": warning: key 'simulation." << (scene.simulation.dt ? "dt" : "cfl")
         << "': the time step exceeds the stability limit; `mmpm run` refuses it unless --force\n";
-  if (const std::string w = usl_time_step_warning(scene, dt); !w.empty()) std::cerr << w << "\n";
-  for (const std::string& w : open_contact_warnings(scene, *sim)) std::cerr << w << "\n";
+  for (const std::string& w : start_warnings(scene, *sim, dt)) std::cerr << w << "\n";
   return 0;
 }
 

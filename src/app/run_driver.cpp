@@ -15,6 +15,7 @@
 #include "app/build_info.hpp"
 #include "app/interrupt.hpp"
 #include "app/output_directory.hpp"
+#include "app/start_warnings.hpp"
 #include "app/timing_table.hpp"
 #include "io/atomic_file.hpp"
 #include "io/checkpoint.hpp"
@@ -22,7 +23,6 @@
 #include "io/summary.hpp"
 #include "scene/error.hpp"
 #include "scene/parse.hpp"
-#include "solver/contact_gap.hpp"
 #include "solver/simulation.hpp"
 
 namespace mmpm {
@@ -229,8 +229,7 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
   check_step_count(scene, dt);
   std::unique_ptr<Simulation> sim = make_simulation(scene);
   if (!resume && opt.warnings) {
-    if (const std::string w = usl_time_step_warning(scene, dt); !w.empty()) std::cerr << w << "\n";
-    for (const std::string& w : open_contact_warnings(scene, *sim)) std::cerr << w << "\n";
+    for (const std::string& w : start_warnings(scene, *sim, dt)) std::cerr << w << "\n";
   }
   const int dim = scene.simulation.dimension;
   DriverState st;

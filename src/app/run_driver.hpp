@@ -19,7 +19,7 @@ struct RunOptions {
   bool force = false;    // run even above the stability limit
   bool progress = true;  // progress line when stderr is a terminal
   bool timing_table = true;
-  bool warnings = true;  // scene warnings (open_contact_warnings) on stderr before a fresh start
+  bool warnings = true;  // scene warnings (start_warnings) on stderr before a fresh start
 };
 
 struct RunOutcome {

@@ -106,8 +106,12 @@ double stable_time_step(const Scene& scene);
 double critical_time_step(const Scene& scene);  // the same with cfl = 1
 double damping_time_step(const Scene& scene);   // 2 / grid.damping (its own limit)
 // `run` and `check`: a warning (one line, empty if none) when scheme = "USL"
-// takes a step above its own limit, about cfl = 1 / sqrt(dimension).
+// takes a step above its measured limit, cfl = 0.75 (docs/validation.md §3.5).
 std::string usl_time_step_warning(const Scene& scene, double dt);
+// `run` and `check`: one warning per interface with force_limit = false whose
+// stiffest finite D makes omega dt > 2 at a node the interface halves
+// (docs/multimaterial.md §8).
+std::vector<std::string> stiff_interface_warnings(const Scene& scene, double dt);
 // `run` and `check`: an end_time / dt beyond any run (1e12 steps) is bad
 // input. (The library steps on past end_time for as long as it is asked.)
 void check_step_count(const Scene& scene, double dt);

@@ -153,6 +153,7 @@ class Stepper final : public Simulation {
   template <unsigned What>
   void gradient_and_stress();
   void build_stress_table();
+  GridUpdateParams grid_update_params() const;
   void grid_update_stage();
   void update_node_ownership(bool rebuilt);
   void update_active_nodes();

@@ -676,8 +676,10 @@ void Stepper<D, Shape, Real>::gradient_and_stress() {
   }
 }
 
+// The grid update's parameters for this step; finish_velocities reads its
+// light nodes from the same values.
 template <int D, class Shape, class Real>
-void Stepper<D, Shape, Real>::grid_update_stage() {
+GridUpdateParams Stepper<D, Shape, Real>::grid_update_params() const {
   GridUpdateParams q;
   q.dt = dt_;
   q.damping = scene_.grid.damping;
@@ -687,6 +689,12 @@ void Stepper<D, Shape, Real>::grid_update_stage() {
   q.rigid_velocity = reinterpret_cast<const double(*)[3]>(rigid_velocity_now_.data());
   q.has_interface_force = mm_.has_interface_forces();
   q.light_threshold = double(usl_light_threshold());
+  return q;
+}
+
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::grid_update_stage() {
+  GridUpdateParams q = grid_update_params();
   // Without pass B nothing changes p before the velocities: one pass, which
   // also applies the supports.
   q.velocities = !plan_.multimaterial;
@@ -767,12 +775,7 @@ void Stepper<D, Shape, Real>::finish_velocities(bool with_dvel) {
   const Supports<Real> s = supports(with_dvel);
   auto hook = [&](int f, std::size_t b, std::size_t e) { apply_supports(G_, GV_, s, f, b, e); };
   if (with_dvel) {
-    LightNodes<D, Real> light;
-    light.threshold = usl_light_threshold();
-    light.dt = Real(dt_);
-    light.alpha = Real(scene_.grid.damping);
-    for (int d = 0; d < D; ++d) light.gacc[d] = Real(gravity_[d]);
-    light.rigid = plan_.rigid.data();
+    const auto light = LightNodes<D, Real>::of(grid_update_params());
     grid_velocities(G_, GV_, mass_threshold_, own_, hook, light);
     collect_support_reactions();
   } else {

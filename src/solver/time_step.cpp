@@ -4,6 +4,7 @@
 #include <limits>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "model/material.hpp"
 #include "scene/error.hpp"
@@ -86,6 +87,70 @@ std::string usl_time_step_warning(const Scene& scene, double dt) {
     << std::setprecision(3) << cfl
     << ". Use a smaller step, or scheme \"MUSL\" (stable to cfl = 1)";
   return m.str();
+}
+
+namespace {
+
+const MaterialSpec* material_named(const Scene& scene, const std::string& name) {
+  for (const auto& m : scene.materials)
+    if (m.name == name) return &m;
+  return nullptr;
+}
+
+}  // namespace
+
+// docs/multimaterial.md §8, "Without the force limit". The explicit
+// interface force is a spring of stiffness D A_i between the two fields'
+// masses; at a node the interface halves (Omega_a = Omega_b = Omega / 2,
+// A_i = Omega / h_perp, m_j = rho_j Omega / 2) its frequency is
+//   omega^2 = D A_i / m_red = (2 D / h) (1 / rho_a + 1 / rho_b)
+// (a rigid partner: 1 / rho = 0), and the explicit step integrates it only
+// while omega dt < 2. h: the smallest cell edge (the largest omega).
+// Measured with force_limit = false (0.05 ms of two_layer.toml, 0.012 ms
+// of sphere_in_cube.toml at 100 um): two_layer stable at D = 3e4, unstable
+// at 6e4 (step 86), bound 4.3e4; sphere_in_cube stable at 3e6, unstable at
+// 1e7 (step 11), bound 2.2e6. Nodes the interface cuts unevenly have other
+// frequencies, so the bound is where trouble starts, not a guarantee.
+std::vector<std::string> stiff_interface_warnings(const Scene& scene, double dt) {
+  std::vector<std::string> out;
+  const int dim = scene.simulation.dimension;
+  double hmin = scene.grid.cell[0];
+  for (int d = 1; d < dim; ++d) hmin = std::min(hmin, scene.grid.cell[d]);
+  for (std::size_t i = 0; i < scene.interactions.size(); ++i) {
+    const InteractionSpec& it = scene.interactions[i];
+    if (it.law != Law::interface || it.force_limit || it.integration != Integration::explicit_)
+      continue;
+    double inverse_density = 0;
+    for (const std::string& name : it.materials) {
+      const MaterialSpec* m = material_named(scene, name);
+      if (m && m->type != MaterialType::rigid && m->density > 0) inverse_density += 1 / m->density;
+    }
+    // The stiffest finite direction (perfect directions stick, no spring).
+    const char* key = nullptr;
+    double D = 0;
+    const auto consider = [&](double value, const char* name) {
+      if (std::isfinite(value) && value > D) D = value, key = name;
+    };
+    consider(it.Dn, "Dn");
+    consider(it.Dt, "Dt");
+    if (it.traction_law == TractionLaw::bilinear) consider(it.Dn_compression, "Dn_compression");
+    if (!key) continue;
+    const double omega_dt = std::sqrt(2 * D / hmin * inverse_density) * dt;
+    if (!(omega_dt > 2)) continue;
+    const double bound = 4 / (dt * dt) * hmin / (2 * inverse_density);
+    std::ostringstream m;
+    m.precision(3);
+    m << (it.where.file.empty() ? scene.source_file : it.where.file);
+    if (it.where.line > 0) m << ":" << it.where.line;
+    m << ": warning: key 'interaction[" << i << "]." << key << "': with force_limit = false, "
+      << key << " = " << D << " is stiffer than this time step integrates: omega dt = " << omega_dt
+      << " at a node the interface halves (explicit integration needs < 2, so " << key
+      << " below about " << bound
+      << "). Expect the run to go unstable; use force_limit = true (the paper's clip), "
+         "integration = \"exact\", or a smaller step";
+    out.push_back(m.str());
+  }
+  return out;
 }
 
 // Grid damping p <- p + dt (f - alpha p) multiplies a free node's momentum

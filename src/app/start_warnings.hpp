@@ -1,0 +1,18 @@
+// The scene warnings `check` and `run` print before a fresh start, one line
+// each, in one order: USL above its measured step limit, interfaces too
+// stiff for the step without the force limit, contact pairs that start
+// apart under the displacement separation.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "scene/scene.hpp"
+
+namespace mmpm {
+
+class Simulation;
+
+std::vector<std::string> start_warnings(const Scene& scene, const Simulation& sim, double dt);
+
+}  // namespace mmpm
