@@ -53,7 +53,7 @@ void bm_mm_scene(benchmark::State& state, const std::string& scene, int threads)
       const auto t0 = Clock::now();
       mm.find_nodes(G, own, &mixed);
       const auto ta = Clock::now();
-      mm.pass_a(G, sim.dt(), own);
+      mm.pass_a(G, sim.dt(), sim.dt(), own);
       const auto tb = Clock::now();
       for (int k = 0; k < passes_b; ++k) mm.pass_b(G, own, k == 0);
       const auto t1 = Clock::now();

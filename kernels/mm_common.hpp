@@ -52,6 +52,14 @@ struct MMConfig {
   const PairParams<Real>* params = nullptr;
   const unsigned char* rigid = nullptr;  // F flags; null = no rigid field
   Real dt = 0;                           // time step
+  // The step the stick decisions of §4.4 (force limit) and §4.5 (ωΔt above
+  // kExactStickOmegaDt) are made for: the run's regular step, also in a last
+  // step shortened to land on end_time (Stepper::step_within); 0: dt. With
+  // the shortened dt those tests let directions go that every earlier step
+  // held stuck, and their springs, at separations stick had frozen, came
+  // back at once: the last row of a stiff sphere_in_cube run read 5.7 times
+  // the interface energy of the row before (docs/multimaterial.md §8).
+  Real limit_dt = 0;
   // 2D only: multiplies the area (P-20). Use the thickness t when grid.vol holds areas
   // (Σ S_ip A_p, as in P-19); use 1 when grid.vol already holds A_p·t.
   Real thickness = 1;

@@ -189,10 +189,13 @@ inline Real oscillator_sin_term(Real theta) {
 
 template <class Real>
 SpringStep<Real> exact_spring_force(Real stiffness, Real m_red, Real dt, Real separation,
-                                    Real momentum_change, Real force_difference = 0) {
+                                    Real momentum_change, Real force_difference = 0,
+                                    Real stick_dt = 0) {
   SpringStep<Real> r;
-  r.omega_dt = dt * std::sqrt(stiffness / m_red);
-  if (r.omega_dt > Real(kExactStickOmegaDt)) {
+  const Real omega = std::sqrt(stiffness / m_red);
+  r.omega_dt = dt * omega;
+  // stick_dt: the step the stick decision is made for (MMConfig::limit_dt).
+  if ((stick_dt > 0 ? stick_dt : dt) * omega > Real(kExactStickOmegaDt)) {
     r.stick = true;
     return r;
   }

@@ -306,7 +306,7 @@ struct DirectionOutcome {
 template <class Real>
 DirectionOutcome<Real> interface_direction(const PairParams<Real>& pp, bool perfect, Real stiffness,
                                            Real traction, Real energy_density, Real area,
-                                           Real m_red, Real dt, Real separation,
+                                           Real m_red, Real dt, Real limit_dt, Real separation,
                                            Real momentum_change, Real force_diff) {
   DirectionOutcome<Real> o;
   if (perfect) {  // always stick, zero energy, no force limit computation
@@ -314,8 +314,8 @@ DirectionOutcome<Real> interface_direction(const PairParams<Real>& pp, bool perf
     return o;
   }
   if (pp.integration == Integration::exact) {
-    const SpringStep<Real> s =
-        exact_spring_force(stiffness * area, m_red, dt, separation, momentum_change, force_diff);
+    const SpringStep<Real> s = exact_spring_force(stiffness * area, m_red, dt, separation,
+                                                  momentum_change, force_diff, limit_dt);
     if (s.stick) {
       o.stick = o.limited = true;
       return o;
@@ -327,7 +327,7 @@ DirectionOutcome<Real> interface_direction(const PairParams<Real>& pp, bool perf
   const Real force = traction * area;
   if (pp.force_limit &&
       exceeds_force_limit(
-          force, force_limit_component(m_red, dt, separation, momentum_change, force_diff))) {
+          force, force_limit_component(m_red, limit_dt, separation, momentum_change, force_diff))) {
     o.stick = o.limited = true;
     return o;
   }
@@ -363,8 +363,8 @@ InteractionResult<D, Real> interact_pass_a(const MaterialSide<D, Real>& a,
                                            const MaterialSide<D, Real>& b, bool b_is_rigid,
                                            const PairParams<Real>& pp, Real sign,
                                            const std::array<Real, 3>& node_position,
-                                           const std::array<Real, 3>& h, Real dt, Real thickness,
-                                           bool use_force_difference,
+                                           const std::array<Real, 3>& h, Real dt, Real limit_dt,
+                                           Real thickness, bool use_force_difference,
                                            SavedGeometry<D, Real>* save) {
   InteractionResult<D, Real> r;
   const PairGeometry<D, Real> G =
@@ -387,10 +387,10 @@ InteractionResult<D, Real> interact_pass_a(const MaterialSide<D, Real>& a,
 
   const DirectionOutcome<Real> on =
       interface_direction(pp, tr.perfect_n, tr.stiffness_n, tr.normal, tr.energy_n, area, m_red, dt,
-                          dn, dot<D, Real>(G.dp, G.n), dot<D, Real>(df, G.n));
+                          limit_dt, dn, dot<D, Real>(G.dp, G.n), dot<D, Real>(df, G.n));
   const DirectionOutcome<Real> ot =
       interface_direction(pp, tr.perfect_t, tr.stiffness_t, tr.tangential, tr.energy_t, area, m_red,
-                          dt, G.delta_t, dot<D, Real>(G.dp, G.t), dot<D, Real>(df, G.t));
+                          dt, limit_dt, G.delta_t, dot<D, Real>(G.dp, G.t), dot<D, Real>(df, G.t));
   r.stick = (on.stick ? kStickNormal : 0) | (ot.stick ? kStickTangential : 0);
   if (on.stick && ot.stick) r.stick |= kStickBoth;
   r.limited = int(on.limited) + int(ot.limited);
@@ -548,6 +548,7 @@ void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::si
   const std::array<Real, 3> x_node =
       needs.position ? grid.position(node) : std::array<Real, 3>{0, 0, 0};
   const Real inv_dt = Real(1) / cfg.dt;
+  const Real limit_dt = cfg.limit_dt > 0 ? cfg.limit_dt : cfg.dt;
   auto is_rigid = [&](int field) { return cfg.rigid != nullptr && cfg.rigid[field] != 0; };
   auto params_of = [&](int fa, int fb) -> const PairParams<Real>* {
     const int idx = cfg.pair[fa * F + fb];
@@ -559,7 +560,7 @@ void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::si
     const Real sign = field_a == pp.first_field ? Real(1) : Real(-1);
     const std::size_t slot = k * std::size_t(F) + std::size_t(field_a);
     if constexpr (kPassA) {
-      return interact_pass_a<D, Real>(a, b, b_rigid, pp, sign, x_node, grid.h, cfg.dt,
+      return interact_pass_a<D, Real>(a, b, b_rigid, pp, sign, x_node, grid.h, cfg.dt, limit_dt,
                                       cfg.thickness, cfg.use_force_difference,
                                       geometry_out ? &geometry_out[slot] : nullptr);
     } else {
@@ -703,7 +704,9 @@ void process_chunk(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg,
       bn.position = method == NormalMethod::radial;
       bn.force = cfg.use_force_difference;
       gather_batch<D, Real>(grid, bn, B);
-      pass_a_batch<D, Real>(B, grid.h, cfg.dt, cfg.thickness, cfg.use_force_difference);
+      // The lanes read dt in the force limit only (explicit integration).
+      pass_a_batch<D, Real>(B, grid.h, cfg.limit_dt > 0 ? cfg.limit_dt : cfg.dt, cfg.thickness,
+                            cfg.use_force_difference);
     } else {
       bn.vol = bn.geometry = false;
       gather_batch<D, Real>(grid, bn, B);

@@ -196,6 +196,34 @@ TEST(MultimaterialContact, PositionMethodSubtractsContactOffset) {
     }
 }
 
+// The same in 3D with the gap along a normal off the axes, n = (1, 1, 1)/√3,
+// cell 2 × 2 × 2 (h⊥ = 2): the positions differ by exactly gap · n, so the
+// tangential remainder is rounding. Taken as the tangent it gave h⊥ ≈ 0 and
+// no offset at all (contact only once the gap closed); now contact iff
+// gap < 1.6 (kernels/mm_normals.hpp resolved_opening_squared). Per node
+// and batched.
+TEST(MultimaterialContact, PositionMethodOffsetWithTheGapAlongAnOffAxisNormal) {
+  for (const bool batch : {false, true})
+    for (const double gap : {1.1, 1.5, 1.7, 2.5}) {
+      TestGrid<3, double> grid({1, 1, 1}, 2, {2, 2, 2});
+      const double g = gap / std::sqrt(3.0);
+      grid.set(0, 0, 2.0, {1, 1, 1}, {10.0, 3.0, 7.0}, 0.5);
+      grid.set(1, 0, 3.0, {-1, -1, -1}, {10.0 + g, 3.0 + g, 7.0 + g}, 0.5);
+      TestSetup<3, double> setup(2);
+      auto pp = contact_params<double>(Law::frictionless);
+      pp.normal_vector = {1, 1, 1};
+      pp.separation = Separation::position;
+      setup.connect(0, 1, pp);
+      setup.cfg.batch_pairs = batch;
+      MMStats stats;
+      std::vector<unsigned char> flags;
+      run_pass_a(grid, setup, stats, flags);
+      // In contact: both take the centre-of-mass normal velocity, -0.2 per axis.
+      const double expected = gap < 1.6 ? -0.2 : 1.0;
+      EXPECT_NEAR(grid.velocity(0, 0, 0), expected, kTol) << "gap " << gap << " batch " << batch;
+    }
+}
+
 TEST(MultimaterialContact, VolumeScreeningSkipsSmallNodes) {
   for (const double omega_min : {0.9, 1.1}) {  // Ω_i = 1.0
     TwoBodyNode t;

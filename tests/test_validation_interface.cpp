@@ -699,6 +699,35 @@ TEST(ValidationInterface, SphereInCubeWithoutForceLimit) {
   EXPECT_THROW(run_cube(1e7, 0.1, 1, 0.012, no_limit), SimulationError);
 }
 
+// A run's last step is shortened to land on end_time (Stepper::step_within).
+// The force limit (§4.4) takes its decisions for the run's regular step
+// (MMConfig::limit_dt): taken for the short step, whose f_lim is
+// (dt / dt_short)^2 larger, they let go every direction the earlier steps
+// held stuck, and the last row, the one summary.json reports, read other
+// energies: sphere_in_cube at 2 ppc and D = 1e6 had its interface energy
+// go from 0.00289 to 0.0164 mJ (limited directions 324 -> 120) in its last,
+// short step. Here 100 um, 1 ppc, D = 1e4: two runs of 600 regular steps,
+// then one regular step and one of 0.01 dt. Pass A reads the state at the
+// start of the step, so the two must report the same limited directions
+// (114) and the same interface energy (1e-12).
+TEST(ValidationInterface, ShortLastStepKeepsTheStickDecisions) {
+  const std::vector<std::string> cube = {
+      "interaction[0].Dn=1e4", "interaction[0].Dt=1e4",        "grid.cell=[0.1,0.1,0.1]",
+      "grid.cells=[13,13,13]", "body[0].particles_per_cell=1", "body[1].particles_per_cell=1"};
+  auto regular = make_scene("sphere_in_cube.toml", cube),
+       shortened = make_scene("sphere_in_cube.toml", cube);
+  for (int k = 0; k < 600; ++k) regular->step(), shortened->step();
+  regular->step();
+  shortened->step_within(shortened->time() + 0.01 * shortened->dt());
+  const long limited = regular->counters().force_limited_nodes;
+  std::printf("[short last step] limited %ld / %ld, interface energy %.9g / %.9g\n", limited,
+              shortened->counters().force_limited_nodes, regular->energies().interface,
+              shortened->energies().interface);
+  EXPECT_GT(limited, 0);
+  EXPECT_EQ(shortened->counters().force_limited_nodes, limited);
+  EXPECT_NEAR(shortened->energies().interface / regular->energies().interface, 1.0, 1e-12);
+}
+
 // 100 um and 50 um cells, 2 particles per cell per direction, at 1/D = 1e-6 (near
 // perfect), 1e-4 (transition) and 1e-2 (nearly debonded): both K within 5 % of CSA at
 // 50 um, and at 1/D = 1e-4 the 50 um error is smaller than the 100 um error.

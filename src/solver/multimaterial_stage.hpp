@@ -78,9 +78,11 @@ class MultimaterialStage {
   const std::vector<std::uint32_t>& nodes() const { return list_; }
 
   // After find_nodes and the multimaterial fields' P2G.
-  void pass_a(GridView<D, Real>& grid, double dt, const NodeOwnership& own) {
+  // limit_dt: the step the stick decisions are made for (MMConfig::limit_dt).
+  void pass_a(GridView<D, Real>& grid, double dt, double limit_dt, const NodeOwnership& own) {
     if (!enabled_) return;
     cfg_.dt = Real(dt);
+    cfg_.limit_dt = Real(limit_dt);
     stats_.reset(fields_);
     multimaterial_pass_a(grid, list_, cfg_, stats_, stick_flags_, own, &geometry_);
   }

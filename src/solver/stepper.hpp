@@ -175,6 +175,9 @@ class Stepper final : public Simulation {
   std::vector<MaterialModel> materials_;
   std::vector<BoundaryNodes> boundaries_;
   double dt_ = 0, time_ = 0;
+  // While step_within shortens dt_ to land on end_time: the regular step,
+  // for the multimaterial pass's stick decisions (MMConfig::limit_dt); else 0.
+  double regular_dt_ = 0;
   long step_ = 0;
   Real thickness_ = 1;
   Real mass_threshold_ = 0;

@@ -868,7 +868,7 @@ void Stepper<D, Shape, Real>::step() {
     p2g_multimaterial();
     toc(kStageP2G);
     tic();
-    mm_.pass_a(G_, dt_, own_);
+    mm_.pass_a(G_, dt_, regular_dt_ > 0 ? regular_dt_ : dt_, own_);
     toc(kStageMultimaterial);
   }
 
@@ -940,6 +940,9 @@ void Stepper<D, Shape, Real>::step() {
 // Every stage reads dt_ when it runs and keeps nothing that depends on it
 // for the next step (the multimaterial pass takes it per call, the fused
 // tail's P2G does not use it), so one shortened step needs no other state.
+// One exception, on purpose: the multimaterial pass decides which interface
+// directions stick for the regular step (regular_dt_, MMConfig::limit_dt),
+// so the last row does not depend on how short the last step is.
 // time_ + (t_end - time_) is t_end exactly: the difference is exact
 // (Sterbenz) once time_ is within a step of t_end, and so is the sum.
 template <int D, class Shape, class Real>
@@ -948,13 +951,16 @@ void Stepper<D, Shape, Real>::step_within(double t_end) {
   if (!(left > 0 && left < dt_)) return step();
   const double regular = dt_;
   dt_ = left;
+  regular_dt_ = regular;
   try {
     step();
   } catch (...) {
     dt_ = regular;
+    regular_dt_ = 0;
     throw;
   }
   dt_ = regular;
+  regular_dt_ = 0;
 }
 
 template <int D, class Shape, class Real>
