@@ -74,8 +74,8 @@ VecD<D, Real> normal_radial(const std::array<Real, 3>& node_position,
 // and so does the 3D h⊥ (§4.2), and the contact area (P-20) divides by it. In
 // sphere_in_cube (radial normal, radial opening) one node's area came out 2e14
 // instead of 0.01: an interface force 16 orders too large, which made every
-// force_limit = false run unstable within 6 steps, even at Dn = Dt = 1e-3, and
-// turned the node to stick with the limit on (docs/multimaterial.md §3.2).
+// force_limit = false run unstable within 23 steps, even at Dn = Dt = 1e-3, and
+// turned the node to stick with the limit on (docs/multimaterial.md §4).
 // Compared as squares: no square root for the test.
 template <class Real>
 inline Real resolved_opening_squared(Real opening_t2, Real delta2) {

@@ -676,12 +676,13 @@ TEST(ValidationInterface, StiffnessBoundWithoutForceLimit) {
 // The paper's Fig. 12 "no force limits" curve, at 100 um and 1 ppc for
 // 12 us: where the limit never acts (1/D = 1e-2, 1e-4) K from pressure is
 // the limited run's within 0.5 %; at 1/D = 1e-6 the run completes and K
-// rises above the perfect interface's CSA value (measured 3330 against
-// 3062; limited 2967), as the paper says ("K rises above the theoretical
-// limit and keeps rising until the calculations become unstable"); at
-// 1/D = 1e-7 (omega dt = 4.3 by the bound above) it goes unstable. Before
-// the tangent fix (mm_normals.hpp resolved_opening_squared) every one of
-// these runs stopped within 11 steps.
+// rises above the perfect interface's CSA value (measured 3371 against
+// 3062 in this loop, 3330 with `mmpm run`; the limited run 2967), as the
+// paper says ("K rises above the theoretical limit and keeps rising until
+// the calculations become unstable"); at 1/D = 1e-7 (omega dt = 4.3 by the
+// bound above) it goes unstable. Before the tangent fix (mm_normals.hpp
+// resolved_opening_squared) every one of these runs stopped as unstable
+// within a few steps (docs/interface_validation.md, Finding 3).
 TEST(ValidationInterface, SphereInCubeWithoutForceLimit) {
   const std::vector<std::string> no_limit = {"interaction[0].force_limit=false"};
   for (const double D : {1e2, 1e4}) {
