@@ -17,6 +17,11 @@ namespace mmpm {
 template <int D, class Real>
 using VecD = std::array<Real, D>;
 
+// ALGORITHM §4.3: at a node, a material field of at most this fraction of the
+// lightest particle's mass is a sliver, empty to contact and interfaces
+// (MultimaterialStage) and a light node to USL (Stepper::usl_light_threshold).
+inline constexpr double kSliverMassFraction = 1e-6;
+
 // Properties of one interacting material pair (one [[interaction]] of the scene).
 template <class Real>
 struct PairParams {
@@ -60,6 +65,7 @@ struct MMConfig {
   // back at once: the last row of a stiff sphere_in_cube run read 5.7 times
   // the interface energy of the row before (docs/multimaterial.md §8).
   Real limit_dt = 0;
+  Real stick_dt() const { return limit_dt > 0 ? limit_dt : dt; }
   // 2D only: multiplies the area (P-20). Use the thickness t when grid.vol holds areas
   // (Σ S_ip A_p, as in P-19); use 1 when grid.vol already holds A_p·t.
   Real thickness = 1;

@@ -548,7 +548,6 @@ void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::si
   const std::array<Real, 3> x_node =
       needs.position ? grid.position(node) : std::array<Real, 3>{0, 0, 0};
   const Real inv_dt = Real(1) / cfg.dt;
-  const Real limit_dt = cfg.limit_dt > 0 ? cfg.limit_dt : cfg.dt;
   auto is_rigid = [&](int field) { return cfg.rigid != nullptr && cfg.rigid[field] != 0; };
   auto params_of = [&](int fa, int fb) -> const PairParams<Real>* {
     const int idx = cfg.pair[fa * F + fb];
@@ -560,8 +559,8 @@ void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::si
     const Real sign = field_a == pp.first_field ? Real(1) : Real(-1);
     const std::size_t slot = k * std::size_t(F) + std::size_t(field_a);
     if constexpr (kPassA) {
-      return interact_pass_a<D, Real>(a, b, b_rigid, pp, sign, x_node, grid.h, cfg.dt, limit_dt,
-                                      cfg.thickness, cfg.use_force_difference,
+      return interact_pass_a<D, Real>(a, b, b_rigid, pp, sign, x_node, grid.h, cfg.dt,
+                                      cfg.stick_dt(), cfg.thickness, cfg.use_force_difference,
                                       geometry_out ? &geometry_out[slot] : nullptr);
     } else {
       if (geometry_in)
@@ -705,8 +704,7 @@ void process_chunk(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg,
       bn.force = cfg.use_force_difference;
       gather_batch<D, Real>(grid, bn, B);
       // The lanes read dt in the force limit only (explicit integration).
-      pass_a_batch<D, Real>(B, grid.h, cfg.limit_dt > 0 ? cfg.limit_dt : cfg.dt, cfg.thickness,
-                            cfg.use_force_difference);
+      pass_a_batch<D, Real>(B, grid.h, cfg.stick_dt(), cfg.thickness, cfg.use_force_difference);
     } else {
       bn.vol = bn.geometry = false;
       gather_batch<D, Real>(grid, bn, B);

@@ -58,7 +58,7 @@ class MultimaterialStage {
     cfg_.thickness = D == 2 ? Real(scene.simulation.thickness) : Real(1);
     // Contact and interfaces ignore a material whose nodal mass is a sliver
     // (ALGORITHM §4.3): 1e-6 of the lightest particle, well above round-off.
-    cfg_.mass_threshold = min_particle_mass * Real(1e-6);
+    cfg_.mass_threshold = min_particle_mass * Real(kSliverMassFraction);
     cfg_.dt = Real(dt);
     if (const char* why = validate_multimaterial(grid, cfg_))
       throw InputError(scene.source_file + ": multimaterial setup: " + why);
@@ -78,7 +78,8 @@ class MultimaterialStage {
   const std::vector<std::uint32_t>& nodes() const { return list_; }
 
   // After find_nodes and the multimaterial fields' P2G.
-  // limit_dt: the step the stick decisions are made for (MMConfig::limit_dt).
+  // limit_dt: the step the stick decisions are made for (MMConfig::limit_dt;
+  // 0: dt).
   void pass_a(GridView<D, Real>& grid, double dt, double limit_dt, const NodeOwnership& own) {
     if (!enabled_) return;
     cfg_.dt = Real(dt);

@@ -767,7 +767,7 @@ void Stepper<D, Shape, Real>::add_rigid_work() {
 template <int D, class Shape, class Real>
 Real Stepper<D, Shape, Real>::usl_light_threshold() const {
   if (scene_.simulation.scheme != Scheme::USL) return Real(0);
-  return Real(min_particle_mass_) * Real(1e-6);  // as MultimaterialStage::setup
+  return Real(min_particle_mass_) * Real(kSliverMassFraction);
 }
 
 template <int D, class Shape, class Real>
@@ -868,7 +868,7 @@ void Stepper<D, Shape, Real>::step() {
     p2g_multimaterial();
     toc(kStageP2G);
     tic();
-    mm_.pass_a(G_, dt_, regular_dt_ > 0 ? regular_dt_ : dt_, own_);
+    mm_.pass_a(G_, dt_, regular_dt_, own_);  // 0: decide for dt_
     toc(kStageMultimaterial);
   }
 

@@ -47,15 +47,20 @@ Fastest fastest_motion(const Scene& scene) {
   return f;
 }
 
+// The smallest cell edge over the scene's dimensions.
+double smallest_cell(const Scene& scene) {
+  double h = scene.grid.cell[0];
+  for (int d = 1; d < scene.simulation.dimension; ++d) h = std::min(h, scene.grid.cell[d]);
+  return h;
+}
+
 }  // namespace
 
 // ALGORITHM §2: explicit integration is stable for dt below the time a
 // dilatational wave needs to cross the smallest cell (moving bodies add
 // their speed), and below 2 / grid.damping (damping_time_step).
 double critical_time_step(const Scene& scene) {
-  const int dim = scene.simulation.dimension;
-  double hmin = scene.grid.cell[0];
-  for (int d = 1; d < dim; ++d) hmin = std::min(hmin, scene.grid.cell[d]);
+  const double hmin = smallest_cell(scene);
   const double speed = fastest_wave(scene).speed + fastest_motion(scene).speed;
   const double wave = speed > 0 ? hmin / speed : scene.simulation.end_time;
   return std::min(wave, damping_time_step(scene));
@@ -89,16 +94,6 @@ std::string usl_time_step_warning(const Scene& scene, double dt) {
   return m.str();
 }
 
-namespace {
-
-const MaterialSpec* material_named(const Scene& scene, const std::string& name) {
-  for (const auto& m : scene.materials)
-    if (m.name == name) return &m;
-  return nullptr;
-}
-
-}  // namespace
-
 // docs/multimaterial.md §8, "Without the force limit". The explicit
 // interface force is a spring of stiffness D A_i between the two fields'
 // masses; at a node the interface halves (Omega_a = Omega_b = Omega / 2,
@@ -113,17 +108,17 @@ const MaterialSpec* material_named(const Scene& scene, const std::string& name) 
 // frequencies, so the bound is where trouble starts, not a guarantee.
 std::vector<std::string> stiff_interface_warnings(const Scene& scene, double dt) {
   std::vector<std::string> out;
-  const int dim = scene.simulation.dimension;
-  double hmin = scene.grid.cell[0];
-  for (int d = 1; d < dim; ++d) hmin = std::min(hmin, scene.grid.cell[d]);
+  const double hmin = smallest_cell(scene);
   for (std::size_t i = 0; i < scene.interactions.size(); ++i) {
     const InteractionSpec& it = scene.interactions[i];
     if (it.law != Law::interface || it.force_limit || it.integration != Integration::explicit_)
       continue;
     double inverse_density = 0;
     for (const std::string& name : it.materials) {
-      const MaterialSpec* m = material_named(scene, name);
-      if (m && m->type != MaterialType::rigid && m->density > 0) inverse_density += 1 / m->density;
+      const int k = scene.material_index(name);
+      if (k < 0) continue;
+      const MaterialSpec& m = scene.materials[std::size_t(k)];
+      if (m.type != MaterialType::rigid && m.density > 0) inverse_density += 1 / m.density;
     }
     // The stiffest finite direction (perfect directions stick, no spring).
     const char* key = nullptr;
