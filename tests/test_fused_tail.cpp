@@ -87,8 +87,8 @@ TEST(FusedStepTail, CollisionWithTileChangesBitwise) {
   EXPECT_LT(o.from_tail, o.steps - 1) << "no re-sort: the hand-back path was not exercised";
 }
 
-// The traction ramp shortened to 10 steps, so the tail runs for most of
-// the 80 (it waits for the ramp to end).
+// The traction ramp shortened to a few steps (the tail waited for a ramp to
+// end until the loads left the transfers, 2026-11-28).
 std::string short_ramp(const std::string& file, int steps) {
   const double dt = make_simulation(parse_scene_file(kInputs + file))->dt();
   return "load[0].ramp=" + std::to_string(steps * dt);
@@ -107,11 +107,12 @@ TEST(FusedStepTail, RigidInclineWithGravityBitwise) {
   EXPECT_GT(o.from_tail, 0);
 }
 
+// The loads act at the faces after the P2G (apply_face_tractions), so the
+// tail runs during a ramp as well: every step but the first and those
+// after a re-sort takes its P2G from the tail, with the same bits.
 TEST(FusedStepTail, TractionRampThenTailBitwise) {
   const Outcome o = run_file("series_bars.toml", {short_ramp("series_bars.toml", 20)}, 60, 10);
-  // Off while the ramp runs (about 20 steps), on after it.
-  EXPECT_GT(o.from_tail, 20);
-  EXPECT_LT(o.from_tail, 45);
+  EXPECT_GT(o.from_tail, 55);
 }
 
 std::string three_materials(const std::string& shape) {

@@ -27,9 +27,11 @@ Scene coarse_two_layer(const std::vector<std::string>& extra = {}) {
 // Damped static run to 0.4 ms. With the scene's 10 % PIC blend,
 // kinetic_unresolved (particle KE minus the KE of the grid velocity field)
 // stays below 1e-5 of the stored energy over the second half and does not
-// grow (last value <= 2x its value at 0.2 ms). With pure FLIP (flip = 1)
-// it creeps to > 1e-4 of the stored energy and the run does not settle:
-// the blend is the remedy the measurement favours.
+// grow (last value <= 2x its value at 0.2 ms; it falls ~300x). With pure
+// FLIP (flip = 1) it still creeps: 6e-6 -> 1e-5 of the stored energy from
+// 0.2 to 0.4 ms, 1.9e-5 at 0.8. Until the traction loads acted at the face
+// (docs/validation.md §3.6) the loaded row fed that creep to 1e-2
+// (docs/interface_validation.md Finding 5); the blend remains the remedy.
 double unresolved_fraction(const std::vector<std::string>& extra, double* growth) {
   auto sim = make_simulation(coarse_two_layer(extra));
   testing::run_until(*sim, 0.2);
@@ -49,10 +51,12 @@ double unresolved_fraction(const std::vector<std::string>& extra, double* growth
 
 TEST(LongRuns, UnresolvedKineticEnergyDoesNotCreep) {
   double growth = 0;
-  EXPECT_LT(unresolved_fraction({}, &growth), 1e-5);
+  const double blend = unresolved_fraction({}, &growth);
+  EXPECT_LT(blend, 1e-5);
   EXPECT_LE(growth, 2.0);
-  EXPECT_GT(unresolved_fraction({"simulation.flip=1.0"}, &growth), 1e-4)
-      << "pure FLIP should show the creep";
+  const double flip = unresolved_fraction({"simulation.flip=1.0"}, &growth);
+  EXPECT_GT(flip, 3 * blend) << "pure FLIP should show the creep";
+  EXPECT_GT(growth, 1.3) << "pure FLIP should show the creep";
 }
 
 // [stop] kinetic_ratio = 1e-4 held 400 steps ends the run early with stopped_by = "kinetic_ratio",

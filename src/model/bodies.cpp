@@ -220,6 +220,7 @@ ParticleSeeds make_particles(const Scene& scene) {
                 out.material.push_back(material_index[bi]);
                 out.body.push_back(int(bi));
                 out.traction_force.push_back({0, 0, 0});
+                out.traction_offset.push_back({0, 0, 0});
                 out.load.push_back(-1);
                 alive.push_back(1);
                 cells.add(out.x.size() - 1, {cx, cy, cz});
@@ -239,11 +240,12 @@ ParticleSeeds make_particles(const Scene& scene) {
     out.x[w] = out.x[p], out.v[w] = out.v[p], out.volume[w] = out.volume[p];
     out.half_width[w] = out.half_width[p], out.material[w] = out.material[p];
     out.body[w] = out.body[p], out.traction_force[w] = out.traction_force[p];
-    out.load[w] = out.load[p];
+    out.traction_offset[w] = out.traction_offset[p], out.load[w] = out.load[p];
     ++w;
   }
   out.x.resize(w), out.v.resize(w), out.volume.resize(w), out.half_width.resize(w);
   out.material.resize(w), out.body.resize(w), out.traction_force.resize(w), out.load.resize(w);
+  out.traction_offset.resize(w);
 
   // Traction loads: the outermost particle layer of a box face shares the
   // face's total force (traction × face area) equally.
@@ -275,12 +277,26 @@ ParticleSeeds make_particles(const Scene& scene) {
     for (int d = 0; d < dim; ++d)
       if (d != ax) area *= body.max[d] - body.min[d];
     const Vec3 t = rotate_vector(body, load.traction);
+    // The face's outward normal, and the distance from a particle to the
+    // edge of its (grid-aligned) domain along it: the half-width on an
+    // unrotated face, to the domain's boundary on a rotated one.
+    Vec3 normal{0, 0, 0};
+    normal[std::size_t(ax)] = load.face_max ? 1.0 : -1.0;
+    normal = rotate_vector(body, normal);
+    double reach = 1e300;
+    for (int d = 0; d < dim; ++d)
+      if (std::abs(normal[d]) > 1e-12)
+        reach = std::min(reach, 0.5 * scene.grid.cell[std::size_t(d)] / body.particles_per_cell /
+                                    std::abs(normal[d]));
     for (std::size_t p : face) {
       if (out.load[p] >= 0)
         throw InputError(located(load.where.file, load.where.line, "where",
                                  "two traction loads act on the same particles"));
       out.load[p] = int(li);
-      for (int d = 0; d < dim; ++d) out.traction_force[p][d] = t[d] * area / double(face.size());
+      for (int d = 0; d < dim; ++d) {
+        out.traction_force[p][d] = t[d] * area / double(face.size());
+        out.traction_offset[p][d] = reach * normal[d];
+      }
     }
   }
   return out;

@@ -19,6 +19,9 @@ struct ParticleSeeds {
   std::vector<int> body;
   std::vector<Vec3> traction_force;  // external force on the particle (before the ramp)
   std::vector<int> load;             // index of the traction load acting on it, or -1
+  // Loaded particles: from the particle to the edge of its domain along the
+  // face's outward normal, where the load acts (kernels/face_traction.hpp).
+  std::vector<Vec3> traction_offset;
 };
 
 // Throws InputError when a body holds no particle or a traction load has

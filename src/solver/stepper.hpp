@@ -17,6 +17,7 @@
 #include "kernels/active_nodes.hpp"
 #include "kernels/binning.hpp"
 #include "kernels/constitutive.hpp"
+#include "kernels/face_traction.hpp"
 #include "kernels/g2p.hpp"
 #include "kernels/grid_update.hpp"
 #include "kernels/node_ownership.hpp"
@@ -163,6 +164,10 @@ class Stepper final : public Simulation {
   void add_rigid_work();
   void collect_support_reactions();
   void update_tractions();
+  std::array<const Real*, D> face_offset() const;
+  const std::vector<std::uint32_t>& loaded_particles() const;
+  void apply_face_tractions(const GridView<D, Real>& g) const;
+  void add_face_traction_work();
   [[noreturn]] void fail_particle(const char* stage, std::size_t p, const std::string& why) const;
   void tic() { t0_ = Clock::now(); }
   void toc(Stage s) {
@@ -234,6 +239,9 @@ class Stepper final : public Simulation {
   // Per-material particle lists (several materials, constitutive pass unfused).
   std::vector<std::vector<std::uint32_t>> material_particles_;
   double traction_ramp_end_ = 0;  // tractions are constant after the last load ramp
+  // loaded_particles(): a cache of the load column, refreshed after sorts.
+  mutable std::vector<std::uint32_t> loaded_;
+  mutable bool loaded_stale_ = true;
 
   MultimaterialStage<D, Real> mm_;
   std::vector<double> rigid_velocity_now_;  // per field x 3 at t + dt

@@ -118,6 +118,8 @@ void Stepper<D, Shape, Real>::setup_particles(const ParticleSeeds& seeds) {
     // Base traction force and load index travel with the particle as columns.
     for (int d = 0; d < D; ++d) pcols_.add_real(std::string("fbase") + axis[d], n);
     pcols_.add_byte("load", n);
+    // Where the load acts, from the particle (kernels/face_traction.hpp).
+    for (int d = 0; d < D; ++d) pcols_.add_real(std::string("fofs") + axis[d], n);
   }
   pcols_.key.allocate(n, pcols_.next_slot++);
   P_.key = pcols_.key.data();
@@ -155,6 +157,9 @@ void Stepper<D, Shape, Real>::setup_particles(const ParticleSeeds& seeds) {
       Real* base[3] = {pcols_.real("fbasex"), pcols_.real("fbasey"),
                        D == 3 ? pcols_.real("fbasez") : nullptr};
       for (int d = 0; d < D; ++d) base[d][p] = Real(seeds.traction_force[p][d]);
+      Real* offset[3] = {pcols_.real("fofsx"), pcols_.real("fofsy"),
+                         D == 3 ? pcols_.real("fofsz") : nullptr};
+      for (int d = 0; d < D; ++d) offset[d][p] = Real(seeds.traction_offset[p][d]);
       pcols_.byte("load")[p] = std::uint8_t(seeds.load[p] < 0 ? 255 : seeds.load[p]);
     }
   }
@@ -237,19 +242,68 @@ void Stepper<D, Shape, Real>::sort_particles() {
   schedule_built();
   dirty_ = false;
   grid_ready_ = false;  // a P2G in the old order
+  loaded_stale_ = true;
 }
 
 // The tail can take the next step's P2G when nothing changes what that P2G
 // reads before the next step begins: MUSL (the other schemes' last pass
-// sums the external work in chunk order), the constitutive update in its
-// own pass, and the tractions no longer ramping at the next step
-// (update_tractions would rewrite fext).
+// sums the external work in chunk order) and the constitutive update in its
+// own pass. Tractions do not enter it: the next step adds them at the faces
+// (apply_face_tractions) after update_tractions has set them.
 template <int D, class Shape, class Real>
 bool Stepper<D, Shape, Real>::step_tail_fusable() const {
   if (!scene_.simulation.fuse_step_tail || fuse_constitutive_) return false;
-  if (scene_.simulation.scheme != Scheme::MUSL) return false;
-  const double next_time = time_ + dt_;
-  return !has_traction_ || next_time > traction_ramp_end_ + dt_;
+  return scene_.simulation.scheme == Scheme::MUSL;
+}
+
+template <int D, class Shape, class Real>
+std::array<const Real*, D> Stepper<D, Shape, Real>::face_offset() const {
+  static constexpr const char* axis[3] = {"x", "y", "z"};
+  std::array<const Real*, D> o{};
+  for (int d = 0; d < D; ++d) o[std::size_t(d)] = pcols_.real(std::string("fofs") + axis[d]);
+  return o;
+}
+
+// The particles a traction load acts on, by seed index: their loads then
+// add to the nodes in the same order whatever order the sorts and
+// [simulation] particle_order store them in (the bits do not depend on
+// it). Rebuilt after a sort or a restart moved them.
+template <int D, class Shape, class Real>
+const std::vector<std::uint32_t>& Stepper<D, Shape, Real>::loaded_particles() const {
+  if (loaded_stale_) {
+    loaded_.clear();
+    const std::uint8_t* load = pcols_.byte("load");
+    for (std::size_t p = 0; p < P_.n; ++p)
+      if (load[p] != 255) loaded_.push_back(std::uint32_t(p));
+    const std::uint32_t* id = pcols_.id.data();
+    std::sort(loaded_.begin(), loaded_.end(),
+              [id](std::uint32_t a, std::uint32_t b) { return id[a] < id[b]; });
+    loaded_stale_ = false;
+  }
+  return loaded_;
+}
+
+// The traction loads' nodal forces, at the loaded faces
+// (kernels/face_traction.hpp); the transfers leave them out.
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::apply_face_tractions(const GridView<D, Real>& g) const {
+  if (!has_traction_) return;
+  const std::vector<std::uint32_t>& list = loaded_particles();
+  const std::size_t bad =
+      scatter_face_tractions<D, Shape>(P_, g, face_offset(), list.data(), list.size());
+  if (bad != list.size())
+    fail_particle("p2g", list[bad], "its shape-function stencil left the grid");
+}
+
+// The work of the traction loads over the step: the power of their nodal
+// forces at the grid velocity the strains come from (USL, USF: the updated
+// one, before G2P moves the particles; MUSL: the re-extrapolated one).
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::add_face_traction_work() {
+  if (!has_traction_) return;
+  const std::vector<std::uint32_t>& list = loaded_particles();
+  external_work_ +=
+      dt_ * face_traction_power<D, Shape>(P_, G_, GV_, face_offset(), list.data(), list.size());
 }
 
 // MUSL's last particle stages and the next step's P2G in one pass, tile by
@@ -460,14 +514,11 @@ template <unsigned What>
 std::size_t Stepper<D, Shape, Real>::p2g_tile(const P2GOptions& opt, std::size_t b, std::size_t e) {
   if (plan_.multimaterial && domain_gradient_) {
     constexpr unsigned W = What | ((What & kMultimaterial) ? unsigned(kDomainGradient) : 0u);
-    return has_traction_ ? p2g_range<D, Shape, Real, W, true, true>(P_, G_, opt, b, e)
-                         : p2g_range<D, Shape, Real, W, true, false>(P_, G_, opt, b, e);
+    return p2g_range<D, Shape, Real, W, true, false>(P_, G_, opt, b, e);
   }
-  if (plan_.multimaterial)
-    return has_traction_ ? p2g_range<D, Shape, Real, What, true, true>(P_, G_, opt, b, e)
-                         : p2g_range<D, Shape, Real, What, true, false>(P_, G_, opt, b, e);
-  return has_traction_ ? p2g_range<D, Shape, Real, What, false, true>(P_, G_, opt, b, e)
-                       : p2g_range<D, Shape, Real, What, false, false>(P_, G_, opt, b, e);
+  // Traction loads act at the faces (apply_face_tractions), not in the transfers.
+  if (plan_.multimaterial) return p2g_range<D, Shape, Real, What, true, false>(P_, G_, opt, b, e);
+  return p2g_range<D, Shape, Real, What, false, false>(P_, G_, opt, b, e);
 }
 
 template <int D, class Shape, class Real>
@@ -535,16 +586,10 @@ G2PRangeResult Stepper<D, Shape, Real>::g2p_range_of(const G2PParams& q, std::si
     else
       return g2p_range<D, Shape, Real, What, MF, TR, GR>(P, G_, GV_, q, key_of, b, e);
   };
-  if (plan_.multimaterial) {
-    if (has_traction_)
-      return has_gravity_ ? run.template operator()<true, true, true>()
-                          : run.template operator()<true, true, false>();
+  // The tractions' work is the face loads' (add_face_traction_work).
+  if (plan_.multimaterial)
     return has_gravity_ ? run.template operator()<true, false, true>()
                         : run.template operator()<true, false, false>();
-  }
-  if (has_traction_)
-    return has_gravity_ ? run.template operator()<false, true, true>()
-                        : run.template operator()<false, true, false>();
   return has_gravity_ ? run.template operator()<false, false, true>()
                       : run.template operator()<false, false, false>();
 }
@@ -884,6 +929,9 @@ void Stepper<D, Shape, Real>::step() {
   }
 
   tic();
+  apply_face_tractions(G_);
+  toc(kStageP2G);
+  tic();
   grid_update_stage();
   toc(kStageGrid);
   if (mm) {
@@ -898,6 +946,7 @@ void Stepper<D, Shape, Real>::step() {
     toc(kStageGrid);
   }
 
+  if (scheme != Scheme::MUSL) add_face_traction_work();
   if (scheme == Scheme::USL) {
     gradient_and_stress<kUpdateMotion>();
   } else if (scheme == Scheme::USF) {
@@ -927,6 +976,10 @@ void Stepper<D, Shape, Real>::step() {
     tic();
     finish_velocities(false);
     toc(kStageGrid);
+    // MUSL's strain comes from these re-extrapolated velocities; the first
+    // update's can keep a node motion the particles do not take (a static
+    // bar's loaded node moved on, and that work drifted by 8 %).
+    add_face_traction_work();
     if (step_tail_fusable())
       fused_step_tail();
     else
@@ -1196,15 +1249,12 @@ io::GridSnapshot Stepper<D, Shape, Real>::grid_snapshot(
   const P2GOptions opt = p2g_options();
   const bool multi = F > 1;
   std::size_t bad = 0;
-  if (multi && has_traction_)
-    bad = p2g_range_pointwise<D, Shape, Real, What, true, true>(P_, g, opt, 0, P_.n);
-  else if (multi)
+  if (multi)
     bad = p2g_range_pointwise<D, Shape, Real, What, true, false>(P_, g, opt, 0, P_.n);
-  else if (has_traction_)
-    bad = p2g_range_pointwise<D, Shape, Real, What, false, true>(P_, g, opt, 0, P_.n);
   else
     bad = p2g_range_pointwise<D, Shape, Real, What, false, false>(P_, g, opt, 0, P_.n);
   if (bad != P_.n) fail_particle("output", bad, "its shape-function stencil left the grid");
+  apply_face_tractions(g);
 
   // A field's name in dataset names: its material's, when it has one
   // material with a plain name, else field<k>.
@@ -1295,6 +1345,7 @@ void Stepper<D, Shape, Real>::load_state(const std::vector<io::Blob>& blobs) {
   step_ = io::read_scalar_blob<long>(io::find_blob(blobs, "step"));
   time_ = io::read_scalar_blob<double>(io::find_blob(blobs, "time"));
   external_work_ = io::read_scalar_blob<double>(io::find_blob(blobs, "external_work"));
+  loaded_stale_ = true;
   damping_loss_ = io::read_scalar_blob<double>(io::find_blob(blobs, "damping_loss"));
   dirty_ = io::read_scalar_blob<int>(io::find_blob(blobs, "dirty")) != 0;
   grid_ready_ = false;  // the grid is not in the checkpoint: the next step scatters it again

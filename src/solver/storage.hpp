@@ -49,6 +49,11 @@ struct ColumnSet {
       if (real_names[i] == name) return reals[i].data();
     return nullptr;
   }
+  const Real* real(const std::string& name) const {
+    for (std::size_t i = 0; i < real_names.size(); ++i)
+      if (real_names[i] == name) return reals[i].data();
+    return nullptr;
+  }
 };
 
 // Every column of a particle store (seed ids, reals, bytes: a ColumnSet or

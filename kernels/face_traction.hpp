@@ -1,0 +1,127 @@
+// Traction loads applied at the loaded face (ALGORITHM §2 step 2, the
+// external force; docs/validation.md §3.6).
+//
+// A traction acts on the body's boundary: its nodal force is the surface
+// integral f_i = ∫_Γ N_i t dΓ, with N_i evaluated on Γ. Spreading a face
+// particle's share F_p with its own weights S_ip (the particle's volume
+// average) treats it as a body force on the outer particle layer: the layer
+// beyond the load's point of action then carries part of the load (a bar in
+// tension read 0.32 and 1.18 times the applied stress in its last two rows,
+// 2 ppc uGIMP). Here F_p acts at the particle's face point x_p + o_p, where o_p
+// (set at seeding, src/model/bodies.cpp) reaches the edge of the particle's
+// domain along the face's outward normal, through the grid's hat functions.
+// Sum_i w_i = 1 and Sum_i w_i x_i = the face point: the load's resultant and
+// its moment are those of F_p at the face.
+//
+// The hat's nodes are clamped to the particle's own stencil, so the load only
+// reaches nodes the particle's mass reaches (uGIMP and the B-splines always
+// contain them; for linear shapes a face point beyond the particle's cell is
+// moved to the cell's edge).
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+
+#include "kernels/grid_update.hpp"
+#include "kernels/grid_view.hpp"
+#include "kernels/particle_view.hpp"
+
+namespace mmpm {
+
+template <int D, class Shape, class Real>
+struct FaceStencil {
+  static constexpr int S = Shape::S;
+  static constexpr int count = D == 2 ? S * S : S * S * S;
+  std::size_t base = 0;                   // the particle's stencil corner, with its field's offset
+  std::array<double, count> w{};          // hat weights of the face point, x fastest
+  std::array<std::size_t, count> node{};  // offsets relative to base
+
+  // False when the particle's stencil leaves the grid.
+  bool build(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
+             const std::array<const Real*, D>& offset, std::size_t p) {
+    double hat[D][S];
+    int b[D];
+    for (int d = 0; d < D; ++d) {
+      // The particle's stencil, as the transfers find it (kernels/weights.hpp).
+      const Real xi = (P.x[d][p] - G.origin[d]) * (Real(1) / G.h[d]);
+      const Real l = Shape::S == 3 && P.lp[d] ? P.lp[d][p] : Real(0);
+      Real w1[S], d1[S];
+      b[d] = Shape::eval(xi, l, w1, d1);
+      if (b[d] < 0 || b[d] + S > G.nodes_per_dim[d]) return false;
+      double face =
+          (double(P.x[d][p]) + double(offset[d][p]) - double(G.origin[d])) / double(G.h[d]);
+      face = std::clamp(face, double(b[d]), double(b[d] + S - 1));
+      for (int k = 0; k < S; ++k) hat[d][k] = std::max(0.0, 1.0 - std::abs(face - (b[d] + k)));
+    }
+    const std::size_t nx = std::size_t(G.nodes_per_dim[0]);
+    const std::size_t field = P.field ? std::size_t(P.field[p]) * G.nodes : 0;
+    if constexpr (D == 2) {
+      base = field + std::size_t(b[0]) + nx * std::size_t(b[1]);
+      int k = 0;
+      for (int j = 0; j < S; ++j)
+        for (int i = 0; i < S; ++i, ++k) {
+          w[k] = hat[0][i] * hat[1][j];
+          node[k] = std::size_t(i) + nx * std::size_t(j);
+        }
+    } else {
+      const std::size_t nxy = nx * std::size_t(G.nodes_per_dim[1]);
+      base = field + std::size_t(b[0]) + nx * std::size_t(b[1]) + nxy * std::size_t(b[2]);
+      int k = 0;
+      for (int l = 0; l < S; ++l)
+        for (int j = 0; j < S; ++j)
+          for (int i = 0; i < S; ++i, ++k) {
+            w[k] = hat[0][i] * hat[1][j] * hat[2][l];
+            node[k] = std::size_t(i) + nx * std::size_t(j) + nxy * std::size_t(l);
+          }
+    }
+    return true;
+  }
+};
+
+// Adds F_p (P.fext) of the listed particles at their face points to G.f, in
+// list order (one thread: the sums do not depend on the thread count).
+// Returns the index in the list of the first particle whose stencil leaves
+// the grid, or count.
+template <int D, class Shape, class Real>
+std::size_t scatter_face_tractions(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
+                                   const std::array<const Real*, D>& offset,
+                                   const std::uint32_t* list, std::size_t count) {
+  FaceStencil<D, Shape, Real> st;
+  for (std::size_t k = 0; k < count; ++k) {
+    const std::size_t p = list[k];
+    if (!st.build(P, G, offset, p)) return k;
+    for (int i = 0; i < st.count; ++i) {
+      if (st.w[i] == 0) continue;
+      const std::size_t n = st.base + st.node[i];
+      for (int d = 0; d < D; ++d) G.f[d][n] += Real(st.w[i] * double(P.fext[d][p]));
+    }
+  }
+  return count;
+}
+
+// The power of the listed particles' face loads, Sum_p F_p . v(face point),
+// with v the grid velocity the particles move with (GV.vel): the work of
+// the nodal forces scatter_face_tractions added, per unit time.
+template <int D, class Shape, class Real>
+double face_traction_power(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
+                           const GridVelocity<D, Real>& GV,
+                           const std::array<const Real*, D>& offset, const std::uint32_t* list,
+                           std::size_t count) {
+  FaceStencil<D, Shape, Real> st;
+  double power = 0;
+  for (std::size_t k = 0; k < count; ++k) {
+    const std::size_t p = list[k];
+    if (!st.build(P, G, offset, p)) continue;  // the scatter has reported it
+    for (int d = 0; d < D; ++d) {
+      double v = 0;
+      for (int i = 0; i < st.count; ++i) v += st.w[i] * double(GV.vel[d][st.base + st.node[i]]);
+      power += double(P.fext[d][p]) * v;
+    }
+  }
+  return power;
+}
+
+}  // namespace mmpm
