@@ -103,8 +103,8 @@ std::size_t scatter_face_tractions(const ParticleView<D, Real>& P, const GridVie
 }
 
 // The power of the listed particles' face loads, Sum_p F_p . v(face point),
-// with v the grid velocity the particles move with (GV.vel): the work of
-// the nodal forces scatter_face_tractions added, per unit time.
+// v interpolated from GV.vel (the caller chooses which velocity that holds):
+// the power of the nodal forces scatter_face_tractions added.
 template <int D, class Shape, class Real>
 double face_traction_power(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
                            const GridVelocity<D, Real>& GV,

@@ -200,42 +200,10 @@ TEST(FaceTraction, BarInTensionIsUniformToTheLoadedRow) {
 // y = -4.5, loaded on its body-frame face x_max, now the top): the load's
 // direction and its face offset turn with the body. Same tolerances.
 TEST(FaceTraction, RotatedBarLoadsItsFace) {
-  auto sim = make_from_text(R"(
-[simulation]
-dimension = 2
-plane = "stress"
-thickness = 1.0
-end_time = 3.0
-cfl = 0.5
-[grid]
-origin = [3.0, -5.5]
-cell = [0.5, 0.5]
-cells = [8, 24]
-shape = "gimp"
-damping = 20.0
-[[material]]
-name = "m"
-type = "isotropic"
-density = 1.0e-3
-E = 1000.0
-nu = 0.0
-[[body]]
-name = "bar"
-material = "m"
-shape = "box"
-min = [0.0, 0.0]
-max = [10.0, 1.0]
-rotate = 90.0
-particles_per_cell = 2
-[[boundary]]
-where = { y = -4.5 }
-fix = ["x", "y"]
-[[load]]
-kind = "traction"
-where = { body = "bar", face = "x_max" }
-traction = [1.0, 0.0]
-ramp = 0.1
-)");
+  auto sim = make_from_text(bar_in_tension("gimp", "MUSL", 10.0),
+                            {"grid.origin=[3.0,-5.5]", "grid.cells=[8,24]", "body[0].rotate=90.0",
+                             "boundary[0].where={ y = -4.5 }", "boundary[0].fix=[\"x\",\"y\"]",
+                             "boundary[1].where={ y = -4.5 }"});
   run_until(*sim, 3.0);
   const auto pos = field(*sim, "position"), u = field(*sim, "displacement"),
              s = field(*sim, "stress");

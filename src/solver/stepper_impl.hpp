@@ -928,9 +928,11 @@ void Stepper<D, Shape, Real>::step() {
     toc(kStageP2G);
   }
 
-  tic();
-  apply_face_tractions(G_);
-  toc(kStageP2G);
+  if (has_traction_) {  // part of the P2G stage's time, not a pass of its own
+    tic();
+    apply_face_tractions(G_);
+    toc_time(kStageP2G);
+  }
   tic();
   grid_update_stage();
   toc(kStageGrid);
