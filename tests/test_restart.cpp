@@ -294,6 +294,25 @@ void check_killed_run_continues_bitwise(const std::string& scene_text) {
       mmpm::io::read_scalar_blob<double>(mmpm::io::find_blob(blobs, "driver.wall_s"));
   EXPECT_GT(ckpt_wall, 0.0);
 
+  // 2b. A checkpoint without one of the scene's columns (as one written
+  // before the traction loads' face offsets, 2026-11-28) is refused: exit 2,
+  // one message naming the file and the column, and the checkpoint stays.
+  {
+    std::vector<mmpm::io::Blob> lacking;
+    for (const auto& b : blobs)
+      if (b.name != "p.fofsx") lacking.push_back(b);
+    ASSERT_EQ(lacking.size() + 1, blobs.size()) << "the scene has a traction load";
+    mmpm::io::write_checkpoint(dir / "checkpoint.bin", lacking);
+    const CmdResult refused =
+        run_mmpm({"run", "--restart", dir.string(), "--threads", "1", "--quiet"});
+    EXPECT_EQ(refused.exit_code, 2) << refused.describe();
+    EXPECT_NE(refused.err.find("checkpoint.bin"), std::string::npos) << refused.err;
+    EXPECT_NE(refused.err.find("p.fofsx"), std::string::npos) << refused.err;
+    EXPECT_TRUE(fs::exists(dir / "checkpoint.bin"));
+    EXPECT_FALSE(fs::exists(dir / "summary.json"));
+    mmpm::io::write_checkpoint(dir / "checkpoint.bin", blobs);
+  }
+
   // 3. Restart and compare.
   const CmdResult again = run_mmpm({"run", "--restart", dir.string(), "--threads", "1", "--quiet"});
   ASSERT_EQ(again.exit_code, 0) << again.describe();

@@ -242,7 +242,17 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
                                                   : "--out");
   std::unique_ptr<io::RunWriter> writer;
   if (resume) {
-    sim->load_state(*resume);
+    try {
+      sim->load_state(*resume);
+    } catch (const std::runtime_error& e) {
+      // A column or value the scene needs is missing or has another size:
+      // the checkpoint came from another scene or another version of mmpm
+      // (e.g. one from before 2026-11-28 lacks the traction face offsets).
+      throw InputError((dir / "checkpoint.bin").string() + ": " + e.what() +
+                       ": the checkpoint does not hold this scene's state as this mmpm stores "
+                       "it (another scene, or written by another version of mmpm); run the "
+                       "scene again");
+    }
     load_driver_blobs(*resume, st);
     writer = std::make_unique<io::RunWriter>(io::RunWriter::reopen(dir, st.last_snapshot_step));
   } else {
