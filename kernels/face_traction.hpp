@@ -7,9 +7,10 @@
 // average) treats it as a body force on the outer particle layer: the layer
 // beyond the load's point of action then carries part of the load (a bar in
 // tension read 0.32 and 1.18 times the applied stress in its last two rows,
-// 2 ppc uGIMP). Here F_p acts at the particle's face point x_p + o_p, where o_p
-// (set at seeding, src/model/bodies.cpp) reaches the edge of the particle's
-// domain along the face's outward normal, through the grid's hat functions.
+// 2 ppc uGIMP). Here F_p acts at the particle's face point x_p + o_p, through
+// the grid's hat functions; o_p (set at seeding, src/model/bodies.cpp) runs
+// along the face's outward normal to the edge of the particle's domain (on a
+// rotated body's staircase, to the declared face within that domain).
 // Sum_i w_i = 1 and Sum_i w_i x_i = the face point: the load's resultant and
 // its moment are those of F_p at the face.
 //
