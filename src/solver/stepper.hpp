@@ -164,7 +164,6 @@ class Stepper final : public Simulation {
   void add_rigid_work();
   void collect_support_reactions();
   void update_tractions();
-  std::array<const Real*, D> face_offset() const;
   const std::vector<std::uint32_t>& loaded_particles() const;
   void apply_face_tractions(const GridView<D, Real>& g) const;
   void add_face_traction_work();
@@ -246,6 +245,8 @@ class Stepper final : public Simulation {
   // loaded_particles(): a cache of the load column, refreshed after sorts.
   mutable std::vector<std::uint32_t> loaded_;
   mutable bool loaded_stale_ = true;
+  // The loads' face offsets (columns fofs*; kernels/face_traction.hpp).
+  std::array<const Real*, D> face_offset_{};
 
   MultimaterialStage<D, Real> mm_;
   std::vector<double> rigid_velocity_now_;  // per field x 3 at t + dt

@@ -114,12 +114,17 @@ void Stepper<D, Shape, Real>::setup_particles(const ParticleSeeds& seeds) {
   P_.mat = pcols_.add_byte("mat", n);
   std::uint8_t* body = pcols_.add_byte("body", n);
   if (plan_.multimaterial) P_.field = pcols_.add_byte("field", n);
+  Real *fbase[3] = {}, *fofs[3] = {};
+  std::uint8_t* load = nullptr;
   if (has_traction_) {
     // Base traction force and load index travel with the particle as columns.
-    for (int d = 0; d < D; ++d) pcols_.add_real(std::string("fbase") + axis[d], n);
-    pcols_.add_byte("load", n);
+    for (int d = 0; d < D; ++d) fbase[d] = pcols_.add_real(std::string("fbase") + axis[d], n);
+    load = pcols_.add_byte("load", n);
     // Where the load acts, from the particle (kernels/face_traction.hpp).
-    for (int d = 0; d < D; ++d) pcols_.add_real(std::string("fofs") + axis[d], n);
+    for (int d = 0; d < D; ++d) {
+      fofs[d] = pcols_.add_real(std::string("fofs") + axis[d], n);
+      face_offset_[std::size_t(d)] = fofs[d];
+    }
   }
   pcols_.key.allocate(n, pcols_.next_slot++);
   P_.key = pcols_.key.data();
@@ -154,13 +159,11 @@ void Stepper<D, Shape, Real>::setup_particles(const ParticleSeeds& seeds) {
     if (P_.field)
       P_.field[p] = std::uint8_t(plan_.field_of_material[std::size_t(seeds.material[p])]);
     if (has_traction_) {
-      Real* base[3] = {pcols_.real("fbasex"), pcols_.real("fbasey"),
-                       D == 3 ? pcols_.real("fbasez") : nullptr};
-      for (int d = 0; d < D; ++d) base[d][p] = Real(seeds.traction_force[p][d]);
-      Real* offset[3] = {pcols_.real("fofsx"), pcols_.real("fofsy"),
-                         D == 3 ? pcols_.real("fofsz") : nullptr};
-      for (int d = 0; d < D; ++d) offset[d][p] = Real(seeds.traction_offset[p][d]);
-      pcols_.byte("load")[p] = std::uint8_t(seeds.load[p] < 0 ? 255 : seeds.load[p]);
+      for (int d = 0; d < D; ++d) {
+        fbase[d][p] = Real(seeds.traction_force[p][d]);
+        fofs[d][p] = Real(seeds.traction_offset[p][d]);
+      }
+      load[p] = std::uint8_t(seeds.load[p] < 0 ? 255 : seeds.load[p]);
     }
   }
   // Fields lighter than this at a node are empty there (ALGORITHM §4.3):
@@ -256,14 +259,6 @@ bool Stepper<D, Shape, Real>::step_tail_fusable() const {
   return scene_.simulation.scheme == Scheme::MUSL;
 }
 
-template <int D, class Shape, class Real>
-std::array<const Real*, D> Stepper<D, Shape, Real>::face_offset() const {
-  static constexpr const char* axis[3] = {"x", "y", "z"};
-  std::array<const Real*, D> o{};
-  for (int d = 0; d < D; ++d) o[std::size_t(d)] = pcols_.real(std::string("fofs") + axis[d]);
-  return o;
-}
-
 // The particles a traction load acts on, by seed index: their loads then
 // add to the nodes in the same order whatever order the sorts and
 // [simulation] particle_order store them in (the bits do not depend on
@@ -290,7 +285,7 @@ void Stepper<D, Shape, Real>::apply_face_tractions(const GridView<D, Real>& g) c
   if (!has_traction_) return;
   const std::vector<std::uint32_t>& list = loaded_particles();
   const std::size_t bad =
-      scatter_face_tractions<D, Shape>(P_, g, face_offset(), list.data(), list.size());
+      scatter_face_tractions<D, Shape>(P_, g, face_offset_, list.data(), list.size());
   if (bad != list.size())
     fail_particle("p2g", list[bad], "its shape-function stencil left the grid");
 }
@@ -303,7 +298,7 @@ void Stepper<D, Shape, Real>::add_face_traction_work() {
   if (!has_traction_) return;
   const std::vector<std::uint32_t>& list = loaded_particles();
   external_work_ +=
-      dt_ * face_traction_power<D, Shape>(P_, G_, GV_, face_offset(), list.data(), list.size());
+      dt_ * face_traction_power<D, Shape>(P_, G_, GV_, face_offset_, list.data(), list.size());
 }
 
 // MUSL's last particle stages and the next step's P2G in one pass, tile by
