@@ -8,16 +8,17 @@
 // beyond the load's point of action then carries part of the load (a bar in
 // tension read 0.32 and 1.18 times the applied stress in its last two rows,
 // 2 ppc uGIMP). Here F_p acts at the particle's face point x_p + o_p, through
-// the grid's hat functions; o_p (set at seeding, src/model/bodies.cpp) runs
-// along the face's outward normal to the edge of the particle's domain (on a
-// rotated body's staircase, to the declared face within that domain).
-// Sum_i w_i = 1 and Sum_i w_i x_i = the face point: the load's resultant and
-// its moment are those of F_p at the face.
+// the grid's basis functions (grid_basis_at); o_p (set at seeding,
+// src/model/bodies.cpp) runs along the face's outward normal to the edge of
+// the particle's domain (on a rotated body's staircase, to the declared face
+// within that domain). Sum_i w_i = 1 and Sum_i w_i x_i = the face point: the
+// load's resultant and its moment are those of F_p at the face.
 //
-// The hat's nodes are clamped to the particle's own stencil, so the load only
-// reaches nodes the particle's mass reaches (uGIMP and the B-splines always
-// contain them; for linear shapes a face point beyond the particle's cell is
-// moved to the cell's edge).
+// The face point is clamped to where the particle's own stencil holds every
+// node the basis reaches there, so the load only reaches nodes the particle's
+// mass reaches (uGIMP and the B-splines, as seeded at any particles per cell,
+// never need it; for linear shapes a face point beyond the particle's cell moves to
+// the cell's edge).
 #pragma once
 
 #include <algorithm>
@@ -25,25 +26,52 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <type_traits>
 
 #include "kernels/grid_update.hpp"
 #include "kernels/grid_view.hpp"
 #include "kernels/particle_view.hpp"
+#include "kernels/shape.hpp"
 
 namespace mmpm {
+
+// The grid's basis functions N_base+k (k < S) along one axis at r = the face
+// point's coordinate minus the stencil's base, in cells. r is first clamped
+// to where the particle's stencil holds every node the basis reaches (the
+// outer node's weight is 0 at the bound). Linear and uGIMP: the hats (uGIMP's
+// particle weights average them over the particle's domain, so its grid
+// basis is the hat). B-splines: the splines themselves, at the point, which
+// is what the particles' internal forces integrate against; hats there left
+// sigma_xx = 2.43 and -0.11 in a free bar's last two rows (bspline2).
+template <class Shape>
+void grid_basis_at(double r, double (&w)[Shape::S]) {
+  if constexpr (std::is_same_v<Shape, BSpline2Shape>) {
+    r = std::clamp(r, 0.5, 1.5);  // the nodes' distances r, r - 1, r - 2
+    const double a = 1.5 - r, b = r - 1.0, c = r - 0.5;
+    w[0] = 0.5 * a * a;
+    w[1] = 0.75 - b * b;
+    w[2] = 0.5 * c * c;
+  } else if constexpr (std::is_same_v<Shape, BSpline3Shape>) {
+    double dw[4];
+    BSpline3Shape::weights(std::clamp(r, 1.0, 2.0), w, dw);
+  } else {
+    r = std::clamp(r, 0.0, double(Shape::S - 1));
+    for (int k = 0; k < Shape::S; ++k) w[k] = std::max(0.0, 1.0 - std::abs(r - k));
+  }
+}
 
 template <int D, class Shape, class Real>
 struct FaceStencil {
   static constexpr int S = Shape::S;
   static constexpr int count = D == 2 ? S * S : S * S * S;
   std::size_t base = 0;                   // the particle's stencil corner, with its field's offset
-  std::array<double, count> w{};          // hat weights of the face point, x fastest
+  std::array<double, count> w{};          // basis weights of the face point, x fastest
   std::array<std::size_t, count> node{};  // offsets relative to base
 
   // False when the particle's stencil leaves the grid.
   bool build(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
              const std::array<const Real*, D>& offset, std::size_t p) {
-    double hat[D][S];
+    double basis[D][S];
     int b[D];
     for (int d = 0; d < D; ++d) {
       // The particle's stencil, as the transfers find it (kernels/weights.hpp).
@@ -54,8 +82,7 @@ struct FaceStencil {
       if (b[d] < 0 || b[d] + S > G.nodes_per_dim[d]) return false;
       double face =
           (double(P.x[d][p]) + double(offset[d][p]) - double(G.origin[d])) / double(G.h[d]);
-      face = std::clamp(face, double(b[d]), double(b[d] + S - 1));
-      for (int k = 0; k < S; ++k) hat[d][k] = std::max(0.0, 1.0 - std::abs(face - (b[d] + k)));
+      grid_basis_at<Shape>(face - double(b[d]), basis[d]);
     }
     const std::size_t nx = std::size_t(G.nodes_per_dim[0]);
     const std::size_t field = P.field ? std::size_t(P.field[p]) * G.nodes : 0;
@@ -64,7 +91,7 @@ struct FaceStencil {
       int k = 0;
       for (int j = 0; j < S; ++j)
         for (int i = 0; i < S; ++i, ++k) {
-          w[k] = hat[0][i] * hat[1][j];
+          w[k] = basis[0][i] * basis[1][j];
           node[k] = std::size_t(i) + nx * std::size_t(j);
         }
     } else {
@@ -74,7 +101,7 @@ struct FaceStencil {
       for (int l = 0; l < S; ++l)
         for (int j = 0; j < S; ++j)
           for (int i = 0; i < S; ++i, ++k) {
-            w[k] = hat[0][i] * hat[1][j] * hat[2][l];
+            w[k] = basis[0][i] * basis[1][j] * basis[2][l];
             node[k] = std::size_t(i) + nx * std::size_t(j) + nxy * std::size_t(l);
           }
     }

@@ -218,6 +218,14 @@ TEST(Determinism, SingleMaterialLinear2DUSF) {
   check_scene(s.text(), "2D linear double", 40.0);
 }
 
+// The plane y = 4 under the body is a mirror with B-splines
+// (kernels/mirror_supports.hpp): its folds and ghost velocities are serial.
+TEST(Determinism, SingleMaterialBSpline2DMirrorSupport) {
+  BoxScene2D s = single_material("double");
+  s.shape = "bspline2";
+  check_scene(s.text(), "2D bspline2 double", 40.0);
+}
+
 TEST(Determinism, ImperfectInterfacePerfectNormal2D) {
   const RunResult r =
       check_scene(two_materials("double", kPerfectNormalInterface).text(), "2D gimp double", 40.0);

@@ -4,6 +4,7 @@
 // solution, sigma = t everywhere and u = t x / E.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <numbers>
@@ -74,15 +75,26 @@ void check_resultant_and_moment() {
         moment_x[d] += xn[d] * f[d][n];
       }
     }
-    // Linear shapes move a face point beyond the particle's cell to the
-    // cell's edge (particles of a lattice of 2 per cell never need it).
-    const auto cell = [&](double at) { return std::floor((at - G.origin[axis]) / G.h[axis]); };
-    const double face = x[axis] + o[axis];
-    const bool moved = std::is_same_v<Shape, LinearShape> && cell(face) != cell(x[axis]);
-    const double edge = G.origin[axis] + G.h[axis] * (cell(x[axis]) + (o[axis] > 0 ? 1 : 0));
+    // The face point clamped to where the particle's stencil holds the
+    // basis (kernels/face_traction.hpp, grid_basis_at), in cells: linear
+    // shapes to the particle's cell, the quadratic B-spline to within half
+    // a cell of its middle node, the cubic to the particle's cell; uGIMP's
+    // face point (within l <= h/2 of the particle) never leaves its stencil.
+    // Particles seeded on a lattice never need it.
+    const double xi = (x[axis] - G.origin[axis]) / G.h[axis];
+    const double face = (x[axis] + o[axis] - G.origin[axis]) / G.h[axis];
+    double lo = -1e300, hi = 1e300;
+    if constexpr (std::is_same_v<Shape, LinearShape>) {
+      lo = std::floor(xi), hi = lo + 1;
+    } else if constexpr (std::is_same_v<Shape, BSpline2Shape>) {
+      lo = std::floor(xi - 0.5) + 0.5, hi = lo + 1;
+    } else if constexpr (std::is_same_v<Shape, BSpline3Shape>) {
+      lo = std::floor(xi), hi = lo + 1;
+    }
+    const double at_axis = G.origin[axis] + G.h[axis] * std::clamp(face, lo, hi);
     for (int d = 0; d < D; ++d) {
       EXPECT_NEAR(sum[d], F[d], 1e-14) << Shape::name << " trial " << trial;
-      const double at = d != axis ? x[d] : (moved ? edge : face);
+      const double at = d != axis ? x[d] : at_axis;
       EXPECT_NEAR(moment_x[d], at * F[d], 1e-13) << Shape::name << " trial " << trial;
     }
   }

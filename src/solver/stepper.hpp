@@ -13,6 +13,7 @@
 #include <limits>
 #include <numeric>
 #include <sstream>
+#include <type_traits>
 
 #include "kernels/active_nodes.hpp"
 #include "kernels/binning.hpp"
@@ -20,6 +21,7 @@
 #include "kernels/face_traction.hpp"
 #include "kernels/g2p.hpp"
 #include "kernels/grid_update.hpp"
+#include "kernels/mirror_supports.hpp"
 #include "kernels/node_ownership.hpp"
 #include "kernels/p2g.hpp"
 #include "kernels/p2g_multimaterial.hpp"
@@ -163,6 +165,10 @@ class Stepper final : public Simulation {
   Supports<Real> supports(bool with_dvel);
   void add_rigid_work();
   void collect_support_reactions();
+  // Supports on planes as mirrors for the B-splines (kernels/mirror_supports.hpp).
+  void setup_mirrors();
+  void fold_mirrors(unsigned what, bool with_reaction);
+  void mirror_ghost_velocities(bool with_dvel);
   void update_tractions();
   const std::vector<std::uint32_t>& loaded_particles() const;
   void apply_face_tractions(const GridView<D, Real>& g) const;
@@ -253,6 +259,15 @@ class Stepper final : public Simulation {
   std::vector<Vec3> boundary_reaction_;
   std::vector<SupportView<Real>> support_views_;    // per boundary, over boundaries_' lists
   std::vector<std::vector<double>> support_terms_;  // per boundary: reaction terms
+  // Supports on planes that act as mirrors (B-splines only), in boundary
+  // order: the ghost layer past the plane and its partners on the body's side.
+  struct MirrorPlane {
+    std::size_t boundary = 0;
+    std::vector<std::uint32_t> ghost, partner;
+    std::vector<Real> ghost_mass;             // fields x ghosts (MirrorView::ghost_mass)
+    std::array<double, 3> reaction{0, 0, 0};  // this step's folds (fold_mirror)
+  };
+  std::vector<MirrorPlane> mirrors_;
 
   double external_work_ = 0, damping_loss_ = 0;
   std::array<double, kStageCount> stage_s_{};

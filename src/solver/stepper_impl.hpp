@@ -24,6 +24,7 @@ Stepper<D, Shape, Real>::Stepper(const Scene& scene) : scene_(scene), plan_(plan
   domain_gradient_ = plan_.multimaterial && needs_domain_gradient(plan_);
   setup_grid();
   setup_particles(make_particles(scene));
+  setup_mirrors();
   mm_.setup(scene, plan_, G_, Real(min_particle_mass_), dt_);
   support_views_.resize(boundaries_.size());
   support_terms_.resize(boundaries_.size());
@@ -743,6 +744,7 @@ void Stepper<D, Shape, Real>::grid_update_stage() {
     damping_loss_ += grid_update(G_, GV_, q, own_, [&](int f, std::size_t b, std::size_t e) {
       apply_supports(G_, GV_, s, f, b, e);
     });
+    mirror_ghost_velocities(true);
     collect_support_reactions();
   } else {
     damping_loss_ += grid_update(G_, GV_, q, own_);
@@ -776,14 +778,105 @@ Supports<Real> Stepper<D, Shape, Real>::supports(bool with_dvel) {
 }
 
 // The reactions (what a load cell would read) and the supports' work, from
-// the terms the application after the momentum update wrote.
+// the terms the application after the momentum update wrote, plus what a
+// mirror's image added to the body's nodes (fold_mirror).
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::collect_support_reactions() {
+  for (std::size_t b = 0; b < boundaries_.size(); ++b)
+    boundary_reaction_[b] =
+        sum_support_reaction<D>(support_views_[b], G_.fields, plan_.rigid.data());
+  for (MirrorPlane& mp : mirrors_) {
+    for (int d = 0; d < D; ++d) boundary_reaction_[mp.boundary][d] += mp.reaction[d];
+    mp.reaction = {0, 0, 0};
+  }
   for (std::size_t b = 0; b < boundaries_.size(); ++b) {
     const Vec3 vb = boundary_velocity(boundaries_[b], time_, dt_);
-    const Vec3 r = sum_support_reaction<D>(support_views_[b], G_.fields, plan_.rigid.data());
-    boundary_reaction_[b] = r;
-    for (int d = 0; d < D; ++d) external_work_ += r[d] * vb[d] * dt_;
+    for (int d = 0; d < D; ++d) external_work_ += boundary_reaction_[b][d] * vb[d] * dt_;
+  }
+}
+
+// A support on a grid plane mirrors the body (kernels/mirror_supports.hpp)
+// when the shape is a B-spline, the particles within the splines' reach of
+// the plane (2 cells) lie on one side of it, and the partner layer is in the
+// grid. Decided once from the seeded particles, so a restart decides alike.
+// Linear and uGIMP particles on one side of a grid plane never reach past
+// it: nothing to mirror.
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::setup_mirrors() {
+  if constexpr (!std::is_same_v<Shape, BSpline2Shape> && !std::is_same_v<Shape, BSpline3Shape>) {
+    return;
+  } else {
+    for (std::size_t b = 0; b < boundaries_.size(); ++b) {
+      const BoundarySpec& spec = scene_.boundaries[b];
+      if (spec.kind != BoundaryWhere::plane || spec.plane_axis >= D) continue;
+      const int ax = spec.plane_axis;
+      const double h = double(G_.h[ax]);
+      const long plane = std::lround((spec.plane_value - double(G_.origin[ax])) / h);
+      const double a = double(G_.origin[ax]) + double(plane) * h;
+      bool below = false, above = false;
+      for (std::size_t p = 0; p < P_.n; ++p) {
+        if (P_.field && plan_.rigid[P_.field[p]]) continue;
+        const double x = double(P_.x[ax][p]);
+        if (std::abs(x - a) >= 2.0 * h) continue;
+        // A particle on the plane itself sides with neither.
+        below = below || x < a - 1e-9 * h;
+        above = above || x > a + 1e-9 * h;
+      }
+      if (below == above) continue;  // on both sides, or none within reach
+      const long side = above ? 1 : -1;
+      const long ghost = plane - side, partner = plane + side;
+      const long last = long(G_.nodes_per_dim[ax]) - 1;
+      if (ghost < 0 || ghost > last || partner < 0 || partner > last) continue;
+      MirrorPlane mp;
+      mp.boundary = b;
+      const std::size_t stride =
+          ax == 0   ? 1
+          : ax == 1 ? std::size_t(G_.nodes_per_dim[0])
+                    : std::size_t(G_.nodes_per_dim[0]) * std::size_t(G_.nodes_per_dim[1]);
+      for (std::uint32_t n : boundaries_[b].nodes) {
+        mp.ghost.push_back(std::uint32_t(long(n) - side * long(stride)));
+        mp.partner.push_back(std::uint32_t(long(n) + side * long(stride)));
+      }
+      mp.ghost_mass.assign(std::size_t(G_.fields) * mp.ghost.size(), Real(0));
+      mirrors_.push_back(std::move(mp));
+    }
+  }
+}
+
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::fold_mirrors(unsigned what, bool with_reaction) {
+  for (MirrorPlane& mp : mirrors_) {
+    const BoundaryNodes& bc = boundaries_[mp.boundary];
+    MirrorView<Real> v;
+    v.plane = bc.nodes.data();
+    v.ghost = mp.ghost.data();
+    v.partner = mp.partner.data();
+    v.count = mp.ghost.size();
+    v.ghost_mass = mp.ghost_mass.data();
+    const Vec3 vb = boundary_velocity(bc, time_, dt_);
+    for (int d = 0; d < 3; ++d) v.fix[d] = bc.fix[d], v.velocity[d] = Real(vb[d]);
+    for (int f = 0; f < G_.fields; ++f)
+      if (!plan_.rigid[std::size_t(f)])
+        fold_mirror(G_, v, f, what, with_reaction ? mp.reaction.data() : nullptr);
+  }
+}
+
+// In the reverse order of the folds: where two mirrors meet, the ghost of
+// the first (folded first) at the corner takes its velocity from a node in
+// the second's ghost layer, which the second has just set.
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::mirror_ghost_velocities(bool with_dvel) {
+  for (auto it = mirrors_.rbegin(); it != mirrors_.rend(); ++it) {
+    const BoundaryNodes& bc = boundaries_[it->boundary];
+    MirrorView<Real> v;
+    v.plane = bc.nodes.data();
+    v.ghost = it->ghost.data();
+    v.partner = it->partner.data();
+    v.count = it->ghost.size();
+    const Vec3 vb = boundary_velocity(bc, time_, dt_);
+    for (int d = 0; d < 3; ++d) v.fix[d] = bc.fix[d], v.velocity[d] = Real(vb[d]);
+    for (int f = 0; f < G_.fields; ++f)
+      if (!plan_.rigid[std::size_t(f)]) mirror_velocities(G_, GV_, v, f, with_dvel);
   }
 }
 
@@ -817,9 +910,11 @@ void Stepper<D, Shape, Real>::finish_velocities(bool with_dvel) {
   if (with_dvel) {
     const auto light = LightNodes<D, Real>::of(grid_update_params());
     grid_velocities(G_, GV_, mass_threshold_, own_, hook, light);
+    mirror_ghost_velocities(true);
     collect_support_reactions();
   } else {
     grid_momentum_velocities(G_, GV_, mass_threshold_, own_, hook);
+    mirror_ghost_velocities(false);
   }
 }
 
@@ -899,6 +994,8 @@ void Stepper<D, Shape, Real>::step() {
     }
     toc(kStageP2G);
   }
+  // The image's mass and momenta (and USL's forces) before anything reads them.
+  if (!mirrors_.empty()) fold_mirrors(kFoldMass | kFoldMomentum | kFoldForce, true);
 
   if (mm) {
     tic();
@@ -928,6 +1025,8 @@ void Stepper<D, Shape, Real>::step() {
     apply_face_tractions(G_);
     toc_time(kStageP2G);
   }
+  // The forces added since the first fold (USF's P2G, the loads).
+  if (!mirrors_.empty()) fold_mirrors(kFoldForce, true);
   tic();
   grid_update_stage();
   toc(kStageGrid);
@@ -965,6 +1064,7 @@ void Stepper<D, Shape, Real>::step() {
     zero_owned(own_, G_.nodes, G_.fields, momenta);
     g2p_colored<kUpdateMotion | kScatterMomentum>();
     toc(kStageG2P);
+    if (!mirrors_.empty()) fold_mirrors(kFoldMomentum, false);
     if (mm) {
       tic();
       mm_.pass_b(G_, own_, false);
