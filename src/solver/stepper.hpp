@@ -166,7 +166,9 @@ class Stepper final : public Simulation {
   void add_rigid_work();
   void collect_support_reactions();
   // Supports on planes as mirrors for the B-splines (kernels/mirror_supports.hpp).
+  struct MirrorPlane;
   void setup_mirrors();
+  MirrorView<Real> mirror_view(MirrorPlane& mp) const;
   void fold_mirrors(unsigned what, bool with_reaction);
   void mirror_ghost_velocities(bool with_dvel);
   void update_tractions();

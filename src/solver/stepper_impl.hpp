@@ -844,17 +844,23 @@ void Stepper<D, Shape, Real>::setup_mirrors() {
 }
 
 template <int D, class Shape, class Real>
+MirrorView<Real> Stepper<D, Shape, Real>::mirror_view(MirrorPlane& mp) const {
+  const BoundaryNodes& bc = boundaries_[mp.boundary];
+  MirrorView<Real> v;
+  v.plane = bc.nodes.data();
+  v.ghost = mp.ghost.data();
+  v.partner = mp.partner.data();
+  v.count = mp.ghost.size();
+  v.ghost_mass = mp.ghost_mass.data();
+  const Vec3 vb = boundary_velocity(bc, time_, dt_);
+  for (int d = 0; d < 3; ++d) v.fix[d] = bc.fix[d], v.velocity[d] = Real(vb[d]);
+  return v;
+}
+
+template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::fold_mirrors(unsigned what, bool with_reaction) {
   for (MirrorPlane& mp : mirrors_) {
-    const BoundaryNodes& bc = boundaries_[mp.boundary];
-    MirrorView<Real> v;
-    v.plane = bc.nodes.data();
-    v.ghost = mp.ghost.data();
-    v.partner = mp.partner.data();
-    v.count = mp.ghost.size();
-    v.ghost_mass = mp.ghost_mass.data();
-    const Vec3 vb = boundary_velocity(bc, time_, dt_);
-    for (int d = 0; d < 3; ++d) v.fix[d] = bc.fix[d], v.velocity[d] = Real(vb[d]);
+    const MirrorView<Real> v = mirror_view(mp);
     for (int f = 0; f < G_.fields; ++f)
       if (!plan_.rigid[std::size_t(f)])
         fold_mirror(G_, v, f, what, with_reaction ? mp.reaction.data() : nullptr);
@@ -867,14 +873,7 @@ void Stepper<D, Shape, Real>::fold_mirrors(unsigned what, bool with_reaction) {
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::mirror_ghost_velocities(bool with_dvel) {
   for (auto it = mirrors_.rbegin(); it != mirrors_.rend(); ++it) {
-    const BoundaryNodes& bc = boundaries_[it->boundary];
-    MirrorView<Real> v;
-    v.plane = bc.nodes.data();
-    v.ghost = it->ghost.data();
-    v.partner = it->partner.data();
-    v.count = it->ghost.size();
-    const Vec3 vb = boundary_velocity(bc, time_, dt_);
-    for (int d = 0; d < 3; ++d) v.fix[d] = bc.fix[d], v.velocity[d] = Real(vb[d]);
+    const MirrorView<Real> v = mirror_view(*it);
     for (int f = 0; f < G_.fields; ++f)
       if (!plan_.rigid[std::size_t(f)]) mirror_velocities(G_, GV_, v, f, with_dvel);
   }
@@ -995,7 +994,11 @@ void Stepper<D, Shape, Real>::step() {
     toc(kStageP2G);
   }
   // The image's mass and momenta (and USL's forces) before anything reads them.
-  if (!mirrors_.empty()) fold_mirrors(kFoldMass | kFoldMomentum | kFoldForce, true);
+  if (!mirrors_.empty()) {
+    tic();
+    fold_mirrors(kFoldMass | kFoldMomentum | kFoldForce, true);
+    toc_time(kStageGrid);
+  }
 
   if (mm) {
     tic();
@@ -1025,9 +1028,9 @@ void Stepper<D, Shape, Real>::step() {
     apply_face_tractions(G_);
     toc_time(kStageP2G);
   }
+  tic();
   // The forces added since the first fold (USF's P2G, the loads).
   if (!mirrors_.empty()) fold_mirrors(kFoldForce, true);
-  tic();
   grid_update_stage();
   toc(kStageGrid);
   if (mm) {
@@ -1064,7 +1067,11 @@ void Stepper<D, Shape, Real>::step() {
     zero_owned(own_, G_.nodes, G_.fields, momenta);
     g2p_colored<kUpdateMotion | kScatterMomentum>();
     toc(kStageG2P);
-    if (!mirrors_.empty()) fold_mirrors(kFoldMomentum, false);
+    if (!mirrors_.empty()) {
+      tic();
+      fold_mirrors(kFoldMomentum, false);
+      toc_time(kStageGrid);
+    }
     if (mm) {
       tic();
       mm_.pass_b(G_, own_, false);
