@@ -464,4 +464,17 @@ TEST(Restart, KilledFloatRunContinuesBitwise) {
   check_killed_run_continues_bitwise(scene);
 }
 
+// With quadratic B-splines, and the support a plane under the bodies, a
+// mirror (kernels/mirror_supports.hpp): its folds keep no state between
+// steps, so the restart continues bitwise as well.
+TEST(Restart, KilledBSplineRunWithAMirrorContinuesBitwise) {
+  std::string scene = kScene;
+  const auto swap = [&](const std::string& from, const std::string& to) {
+    scene.replace(scene.find(from), from.size(), to);
+  };
+  swap("shape = \"gimp\"", "shape = \"bspline2\"");
+  swap("where = \"y_min\"", "where = { y = 4.0 }");
+  check_killed_run_continues_bitwise(scene);
+}
+
 }  // namespace
