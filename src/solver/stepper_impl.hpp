@@ -796,8 +796,8 @@ void Stepper<D, Shape, Real>::collect_support_reactions() {
 }
 
 // A support on a grid plane mirrors the body (kernels/mirror_supports.hpp)
-// when the shape is a B-spline, the particles within the splines' reach of
-// the plane (2 cells) lie on one side of it, and the partner layer is in the
+// when the shape is a B-spline, the plane fixes its normal component, the particles within the
+// splines' reach of the plane (2 cells) lie on one side of it, and the partner layer is in the
 // grid. Decided once from the seeded particles, so a restart decides alike.
 // Linear and uGIMP particles on one side of a grid plane never reach past
 // it: nothing to mirror.
@@ -810,6 +810,10 @@ void Stepper<D, Shape, Real>::setup_mirrors() {
       const BoundarySpec& spec = scene_.boundaries[b];
       if (spec.kind != BoundaryWhere::plane || spec.plane_axis >= D) continue;
       const int ax = spec.plane_axis;
+      // A plane that leaves its normal free lets the body leave it: an even
+      // image would hold the normal strain at 0 there instead of the normal
+      // stress, so it only fixes its nodes.
+      if (!spec.fix[std::size_t(ax)]) continue;
       const double h = double(G_.h[ax]);
       const long plane = std::lround((spec.plane_value - double(G_.origin[ax])) / h);
       const double a = double(G_.origin[ax]) + double(plane) * h;
