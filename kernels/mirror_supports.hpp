@@ -1,9 +1,10 @@
-// Supports on a grid plane as mirrors, for the B-splines (docs/validation.md
-// §3.7).
+// Supports on a grid plane as mirrors (docs/validation.md §3.7).
 //
 // A quadratic or cubic B-spline reaches one node layer past a plane the body
-// rests on. Fixing only the plane's nodes leaves that layer free (sigma_xx =
-// 0 and 2.34 in a supported bar's first two rows); fixing it too forces a
+// rests on, and linear and uGIMP particles do once compression moves them
+// (or their domains) past it. Fixing only the plane's nodes leaves that
+// layer free (sigma_xx = 0 and 2.34 in a supported B-spline bar's first two
+// rows, -2.80 and +0.97 in a compressed uGIMP bar's); fixing it too forces a
 // kink the splines cannot represent (1.06 and 1.27). A support on a plane is
 // a symmetry plane: the body continued by its mirror image, the fixed
 // components odd, the free ones even. The image's particles add to a node q

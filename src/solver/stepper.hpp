@@ -165,7 +165,7 @@ class Stepper final : public Simulation {
   Supports<Real> supports(bool with_dvel);
   void add_rigid_work();
   void collect_support_reactions();
-  // Supports on planes as mirrors for the B-splines (kernels/mirror_supports.hpp).
+  // Supports on planes as mirrors (kernels/mirror_supports.hpp).
   struct MirrorPlane;
   void setup_mirrors();
   MirrorView<Real> mirror_view(MirrorPlane& mp) const;
@@ -261,8 +261,8 @@ class Stepper final : public Simulation {
   std::vector<Vec3> boundary_reaction_;
   std::vector<SupportView<Real>> support_views_;    // per boundary, over boundaries_' lists
   std::vector<std::vector<double>> support_terms_;  // per boundary: reaction terms
-  // Supports on planes that act as mirrors (B-splines only), in boundary
-  // order: the ghost layer past the plane and its partners on the body's side.
+  // Supports on planes that act as mirrors, in boundary order: the ghost
+  // layer past the plane and its partners on the body's side.
   struct MirrorPlane {
     std::size_t boundary = 0;
     std::vector<std::uint32_t> ghost, partner;
