@@ -797,12 +797,13 @@ void Stepper<D, Shape, Real>::collect_support_reactions() {
 
 // A support on a grid plane mirrors the body (kernels/mirror_supports.hpp)
 // when it fixes its normal component, the particles within 2 cells of it
-// (the splines' reach) lie on one side of it, and the partner layer is in
-// the grid. Decided once from the seeded particles, so a restart decides
-// alike. Every shape: the splines always reach the layer behind the plane,
-// and linear and uGIMP particles do once compression moves them (or their
-// domains) past it; a compressed uGIMP bar read -2.80 and +0.97 t in its
-// first rows with that layer free (docs/validation.md §3.7).
+// (the splines' reach; all particles if none is that close) lie on one
+// side of it, and the partner layer is in the grid. Decided once from the
+// seeded particles, so a restart decides alike. Every shape: the splines
+// always reach the layer behind the plane, and linear and uGIMP particles
+// do once compression moves them (or their domains) past it; a compressed
+// uGIMP bar read -2.80 and +0.97 t in its first rows with that layer free
+// (docs/validation.md §3.7).
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::setup_mirrors() {
   for (std::size_t b = 0; b < boundaries_.size(); ++b) {
@@ -816,16 +817,22 @@ void Stepper<D, Shape, Real>::setup_mirrors() {
     const double h = double(G_.h[ax]);
     const long plane = std::lround((spec.plane_value - double(G_.origin[ax])) / h);
     const double a = double(G_.origin[ax]) + double(plane) * h;
-    bool below = false, above = false;
+    // Which side the body is on: from the particles within reach of the
+    // plane, or, with none there (a body that will fall onto it), from all.
+    bool below = false, above = false, all_below = false, all_above = false;
     for (std::size_t p = 0; p < P_.n; ++p) {
       if (P_.field && plan_.rigid[P_.field[p]]) continue;
       const double x = double(P_.x[ax][p]);
-      if (std::abs(x - a) >= 2.0 * h) continue;
       // A particle on the plane itself sides with neither.
-      below = below || x < a - 1e-9 * h;
-      above = above || x > a + 1e-9 * h;
+      const bool on_below = x<a - 1e-9 * h, on_above = x> a + 1e-9 * h;
+      all_below = all_below || on_below;
+      all_above = all_above || on_above;
+      if (std::abs(x - a) >= 2.0 * h) continue;
+      below = below || on_below;
+      above = above || on_above;
     }
-    if (below == above) continue;  // on both sides, or none within reach
+    if (!below && !above) below = all_below, above = all_above;
+    if (below == above) continue;  // on both sides, or no particle at all
     const long side = above ? 1 : -1;
     const long ghost = plane - side, partner = plane + side;
     const long last = long(G_.nodes_per_dim[ax]) - 1;
