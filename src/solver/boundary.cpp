@@ -30,6 +30,8 @@ std::vector<BoundaryNodes> resolve_boundaries(const Scene& scene) {
       if (std::abs(k - plane_index) > 1e-6 || plane_index < 0 || plane_index > g.cells[ax])
         throw InputError(located(spec.where.file, spec.where.line, "where",
                                  "the plane must lie on a grid node plane inside the grid"));
+      b.plane_axis = ax;
+      b.plane_index = plane_index;
     }
     for (std::size_t i = 0; i < total; ++i) {
       std::array<std::size_t, 3> k{i % n[0], (i / n[0]) % n[1], i / (n[0] * n[1])};

@@ -13,6 +13,8 @@ namespace mmpm {
 struct BoundaryNodes {
   std::string label;
   std::vector<std::uint32_t> nodes;  // ascending
+  int plane_axis = -1;               // a plane { x = a }: its axis and node index along it; else -1
+  long plane_index = 0;
   std::array<bool, 3> fix{false, false, false};
   Vec3 displacement{0, 0, 0};
   double ramp = 0;

@@ -807,15 +807,15 @@ void Stepper<D, Shape, Real>::collect_support_reactions() {
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::setup_mirrors() {
   for (std::size_t b = 0; b < boundaries_.size(); ++b) {
-    const BoundarySpec& spec = scene_.boundaries[b];
-    if (spec.kind != BoundaryWhere::plane || spec.plane_axis >= D) continue;
-    const int ax = spec.plane_axis;
+    const BoundaryNodes& bc = boundaries_[b];
+    const int ax = bc.plane_axis;
+    if (ax < 0 || ax >= D) continue;
     // A plane that leaves its normal free lets the body leave it: an even
     // image would hold the normal strain at 0 there instead of the normal
     // stress, so it only fixes its nodes.
-    if (!spec.fix[std::size_t(ax)]) continue;
+    if (!bc.fix[std::size_t(ax)]) continue;
     const double h = double(G_.h[ax]);
-    const long plane = std::lround((spec.plane_value - double(G_.origin[ax])) / h);
+    const long plane = bc.plane_index;
     const double a = double(G_.origin[ax]) + double(plane) * h;
     // Which side the body is on: from the particles within reach of the
     // plane, or, with none there (a body that will fall onto it), from all.
@@ -824,7 +824,8 @@ void Stepper<D, Shape, Real>::setup_mirrors() {
       if (P_.field && plan_.rigid[P_.field[p]]) continue;
       const double x = double(P_.x[ax][p]);
       // A particle on the plane itself sides with neither.
-      const bool on_below = x<a - 1e-9 * h, on_above = x> a + 1e-9 * h;
+      const bool on_below = x < a - 1e-9 * h;
+      const bool on_above = x > a + 1e-9 * h;
       all_below = all_below || on_below;
       all_above = all_above || on_above;
       if (std::abs(x - a) >= 2.0 * h) continue;
@@ -843,7 +844,7 @@ void Stepper<D, Shape, Real>::setup_mirrors() {
         ax == 0   ? 1
         : ax == 1 ? std::size_t(G_.nodes_per_dim[0])
                   : std::size_t(G_.nodes_per_dim[0]) * std::size_t(G_.nodes_per_dim[1]);
-    for (std::uint32_t n : boundaries_[b].nodes) {
+    for (std::uint32_t n : bc.nodes) {
       mp.ghost.push_back(std::uint32_t(long(n) - side * long(stride)));
       mp.partner.push_back(std::uint32_t(long(n) + side * long(stride)));
     }
