@@ -517,6 +517,27 @@ TEST(Cli, ContactPairsThatStartApartWarnWithDisplacementSeparation) {
   }
 }
 
+// separation = "extrapolated" needs 2 or more particles per cell per
+// direction (kernels/separation_extrapolation.hpp): `check` warns once per
+// body of the pair's materials seeded 1 per cell, naming the interaction's
+// line; two_layer.toml's own 2 per cell do not warn.
+TEST(Cli, ExtrapolatedSeparationWithOneParticlePerCellWarns) {
+  const std::string scene = source_dir() + "/inputs/two_layer.toml";
+  const std::string extrapolated = "interaction[0].separation=\"extrapolated\"";
+  const CmdResult one =
+      run_mmpm({"check", scene, "--set", extrapolated, "--set", "body[1].particles_per_cell=1"});
+  ASSERT_EQ(one.exit_code, 0) << one.describe();
+  const auto lines = lines_of(one.err);
+  ASSERT_EQ(lines.size(), 1u) << one.describe();
+  const std::string where =
+      scene + ":" + std::to_string(line_of(read_text(scene), "[[interaction]]")) + ":";
+  EXPECT_TRUE(contains(lines[0], where + " warning: key 'interaction[0].separation'")) << lines[0];
+  EXPECT_TRUE(contains(lines[0], "has 1")) << lines[0];
+  const CmdResult two = run_mmpm({"check", scene, "--set", extrapolated});
+  EXPECT_EQ(two.exit_code, 0) << two.describe();
+  EXPECT_EQ(two.err, "") << two.describe();
+}
+
 // Pairs without an [[interaction]] of their own fall back on [simulation]
 // default_law (stick unless set): the same check applies to them. A third
 // material, named in no interaction, lies 1 mm above both blocks of

@@ -261,6 +261,17 @@ TEST(Determinism, ImperfectInterfaceLargeTiles2D) {
   }
 }
 
+// separation = "extrapolated" (kernels/separation_extrapolation.hpp): its
+// moments are scattered color by color and each node is corrected on its own.
+TEST(Determinism, ImperfectInterfaceExtrapolatedSeparation2D) {
+  BoxScene2D s =
+      two_materials("double", std::string(kNumericInterface) + "separation = \"extrapolated\"\n");
+  s.scheme = "MUSL";
+  const RunResult r = check_scene(s.text(), "2D gimp double", 40.0);
+  EXPECT_GT(r.counters.multimaterial_nodes, 0);
+  EXPECT_GT(r.energies.interface, 0.0);
+}
+
 TEST(Determinism, ImperfectInterfaceFloat2D) {
   const RunResult r =
       check_scene(two_materials("float", kNumericInterface).text(), "2D gimp float", 40.0);

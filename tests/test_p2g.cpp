@@ -54,6 +54,7 @@
 #include "kernels/p2g.hpp"
 #include "kernels/p2g_multimaterial.hpp"
 #include "kernels/particle_view.hpp"
+#include "kernels/separation_extrapolation.hpp"
 #include "kernels/shape.hpp"
 #include "kernels/weights.hpp"
 #include "tests/shape_configs.hpp"
@@ -583,6 +584,158 @@ TYPED_TEST(P2G, MultimaterialFieldsFromReachingTilesMatchFullScatterBand) {
 TYPED_TEST(P2G, MultimaterialFieldsFromReachingTilesMatchFullScatterMixed) {
   check_multimaterial_fields<TypeParam::D, typename TypeParam::Shape, typename TypeParam::Real>(
       false, 0.0, 312);
+}
+
+// kernels/separation_extrapolation.hpp: for a displacement field affine in
+// x, u(x) = A x + b with its own A and b in each field, the extrapolated mx /
+// m at every multimaterial node is u(x_node) (the centroid's mx / m is off
+// it by A (x_centroid - x_node), up to 3/8 cell). Particles on a lattice of 2
+// per cell per direction (the spread the extrapolation needs, and a node
+// sqrt(3) standard deviations from its centroid, within
+// kMaxExtrapolation), equal masses, field 1 for x above a grid line (2D 37 x 29, 3D 13 x 12 x 11
+// cells of 0.5 x 0.4 (x 0.6)), so the nodes on and next to that line are
+// multimaterial. Exact on the line, relative to the largest |u|: 1e-11 in
+// double, 2e-5 in float; off it u is read within the stencil (B-splines reach
+// a node 1.25 cells from one particle row, which gives no normal gradient).
+// 2 threads give the 1-thread bits.
+template <int D, class Shape, class Real>
+void check_extrapolated_separation(unsigned seed) {
+  const bool gimp = std::string(Shape::name) == "gimp";
+  const std::array<int, 3> cells = grid_cells<D>();
+  Grid<D, Real> g1(cells, 2), g2(cells, 2);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> U(-1.0, 1.0);
+  double A[2][3][3], b[2][3];
+  for (auto& Af : A)
+    for (auto& row : Af)
+      for (double& a : row) a = 0.01 * U(rng);
+  for (auto& bf : b)
+    for (double& c : bf) c = 0.05 * U(rng);
+  const auto& G = g1.G;
+  const double x_line = double(G.origin[0]) + std::floor(0.5 * cells[0]) * double(G.h[0]);
+  auto u_of = [&](int f, const double* x, int d) {
+    double u = b[f][d];
+    for (int e = 0; e < D; ++e) u += A[f][d][e] * x[e];
+    return u;
+  };
+  Particles<D, Real> p;
+  std::array<int, 3> per{1, 1, 1};  // particles per direction: 2 per cell, 3 cells in from the edge
+  for (int d = 0; d < D; ++d) per[d] = 2 * (cells[d] - 6);
+  const std::size_t n = std::size_t(per[0]) * std::size_t(per[1]) * std::size_t(per[2]);
+  p.n = n;
+  for (int d = 0; d < D; ++d)
+    for (auto* a : {&p.x[d], &p.v[d], &p.x0[d], &p.lp[d], &p.fext[d]}) a->assign(n, Real(0));
+  p.m.resize(n);
+  p.V.assign(n, Real(0.01));
+  for (auto& c : p.s) c.assign(n, Real(0));
+  p.field.resize(n);
+  p.key.assign(n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::size_t rest = i;
+    double x[3] = {0, 0, 0};
+    for (int d = 0; d < D; ++d) {
+      const std::size_t k = rest % std::size_t(per[d]);
+      rest /= std::size_t(per[d]);
+      x[d] = double(G.origin[d]) + (3.0 + 0.25 + 0.5 * double(k)) * double(G.h[d]);
+      p.x[d][i] = Real(x[d]);
+      p.lp[d][i] = Real(0.25);
+    }
+    const int f = x[0] > x_line ? 1 : 0;
+    p.field[i] = std::uint8_t(f);
+    p.m[i] = Real(1.5);
+    for (int d = 0; d < D; ++d) p.x0[d][i] = Real(x[d] - u_of(f, x, d));
+  }
+  P2GOptions opt;
+  opt.inv_thickness = 0.5;
+  TileLayout<D> tiles;
+  tiles.setup(4, cells);
+  auto sorted = p.permuted(sort_by_tile<Shape>(p, G, tiles));
+  const auto P = sorted.view(gimp);
+  TileSchedule r;
+  r.build(tiles, sorted.key.data(), n);
+
+  std::vector<std::vector<Real>> moments[2];
+  std::vector<std::uint32_t> nodes;
+  int threads = 1;
+  for (Grid<D, Real>* g : {&g1, &g2}) {
+    colored_p2g<D, Shape, Real, kAll, true, false>(P, g->G, opt, r, 1);
+    find_multimaterial_nodes(g->G, Real(0), nodes);
+    ASSERT_FALSE(nodes.empty());
+    ReachTiles rt;
+    find_reach_tiles<D, Shape, Real>(g->G, tiles, r, nodes, rt);
+    SeparationMoments<D, Real> M;
+    auto& store = moments[threads - 1];
+    store.assign(std::size_t(D + M.kSym + D * D),
+                 std::vector<Real>(g->G.nodes * 2, std::numeric_limits<Real>::quiet_NaN()));
+    std::size_t k = 0;
+    for (int a = 0; a < D; ++a) M.r[a] = store[k++].data();
+    for (int a = 0; a < M.kSym; ++a) M.rr[std::size_t(a)] = store[k++].data();
+    for (int a = 0; a < D * D; ++a) M.ur[std::size_t(a)] = store[k++].data();
+    omp_set_num_threads(threads);
+    EXPECT_EQ((extrapolate_separation<D, Shape, Real>(P, g->G, M, tiles, r, rt, nodes, nullptr,
+                                                      Real(0), threads == 2)),
+              SIZE_MAX);
+    ++threads;
+  }
+  omp_set_num_threads(2);
+
+  double scale = 0;
+  for (int f = 0; f < 2; ++f)
+    for (int d = 0; d < D; ++d) scale = std::max(scale, std::abs(b[f][d]) + 0.2);
+  const double tol = (sizeof(Real) == 8 ? 1e-11 : 2e-5) * scale;
+  // What the paper's centroid reads: the same sums without the shift.
+  Grid<D, Real> plain(cells, 2);
+  colored_p2g<D, Shape, Real, kAll, true, false>(P, plain.G, opt, r, 1);
+  double norm_A[2] = {0, 0}, max_h = 0;
+  for (int f = 0; f < 2; ++f)
+    for (int d = 0; d < D; ++d)
+      for (int e = 0; e < D; ++e) norm_A[f] += A[f][d][e] * A[f][d][e];
+  for (double& a : norm_A) a = std::sqrt(a);
+  for (int d = 0; d < D; ++d) max_h = std::max(max_h, double(G.h[d]));
+  double worst_on_line = 0, centroid_on_line = 0;
+  std::size_t on_line = 0;
+  for (const std::uint32_t node : nodes) {
+    const auto xn = G.position(node);
+    const double x[3] = {double(xn[0]), double(xn[1]), double(xn[2])};
+    // On the line and inside the particles' box (its ends reach fields from afar too).
+    bool line = std::abs(x[0] - x_line) < 1e-3 * double(G.h[0]);
+    for (int d = 1; d < D; ++d)
+      line = line && x[d] > double(G.origin[d]) + 3.5 * double(G.h[d]) &&
+             x[d] < double(G.origin[d]) + (cells[d] - 3.5) * double(G.h[d]);
+    on_line += line;
+    for (int f = 0; f < 2; ++f) {
+      const std::size_t i = G.at(f, node);
+      for (int d = 0; d < D; ++d) {
+        ASSERT_EQ(std::memcmp(&g1.G.mx[d][i], &g2.G.mx[d][i], sizeof(Real)), 0)
+            << "2 threads vs 1, node " << node << ", field " << f;
+        const double exact = u_of(f, x, d);
+        const double err = std::abs(double(g1.G.mx[d][i]) / double(g1.G.m[i]) - exact);
+        const double centroid_err =
+            std::abs(double(plain.G.mx[d][i]) / double(plain.G.m[i]) - exact);
+        // Off the line, a field can reach a node with one particle row (B-splines:
+        // 1.25 cells away); that direction keeps its centroid's coordinate, so u is
+        // read at a point of the stencil: within |A| times its width.
+        ASSERT_LE(err, norm_A[f] * Shape::S * max_h + tol)
+            << "node " << node << ", field " << f << ", " << d;
+        if (line) {
+          worst_on_line = std::max(worst_on_line, err);
+          centroid_on_line = std::max(centroid_on_line, centroid_err);
+        }
+      }
+    }
+  }
+  std::printf(
+      "[extrapolated separation %s] %zu nodes on the interface: |u - u(x_node)| %.2e "
+      "(centroid %.2e)\n",
+      Shape::name, on_line, worst_on_line, centroid_on_line);
+  EXPECT_GT(on_line, 0u);
+  EXPECT_LT(worst_on_line, tol);
+  EXPECT_GT(centroid_on_line, 100 * tol) << "the centroid is off the node: the test can fail";
+}
+
+TYPED_TEST(P2G, ExtrapolatedSeparationIsExactForAffineDisplacements) {
+  check_extrapolated_separation<TypeParam::D, typename TypeParam::Shape, typename TypeParam::Real>(
+      413);
 }
 
 // The multimaterial node search reading only the nodes of tiles next to

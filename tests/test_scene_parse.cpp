@@ -16,6 +16,7 @@
 #include "scene/error.hpp"
 #include "scene/format.hpp"
 #include "scene/parse.hpp"
+#include "solver/field_plan.hpp"
 
 namespace mmpm {
 namespace {
@@ -1068,6 +1069,39 @@ TEST(SceneParseOverrides, BadOverridesNameSet) {
   const std::string msg = error_of(kBase, {"simulation.end_time"});
   EXPECT_NE(msg.find("--set simulation.end_time"), std::string::npos) << msg;
   EXPECT_NE(msg.find("KEY=VALUE"), std::string::npos) << msg;
+}
+
+// One separation method per scene (mx holds one kind of data,
+// solver/field_plan.cpp): kBase with a third material and a second
+// interaction; "position" there and the first's default "displacement" are
+// rejected, "extrapolated" in both is one method, the displacement kind.
+TEST(SceneParse, OneSeparationMethodPerScene) {
+  auto with_third = [](const std::string& first, const std::string& second) {
+    std::string text = kBase;
+    const std::string dt = "Dt = 5.0\n";
+    const std::size_t at = text.find(dt);
+    EXPECT_NE(at, std::string::npos);
+    text.insert(at + dt.size(), first);
+    return text +
+           "\n[[material]]\nname = \"c\"\ntype = \"isotropic\"\ndensity = 1.0e-3\nE = 100.0\n"
+           "nu = 0.3\n\n[[interaction]]\nmaterials = [\"a\", \"c\"]\nlaw = \"stick\"\n" +
+           second;
+  };
+  try {
+    (void)plan_fields(parse_scene_text(with_third("", "separation = \"position\"\n"), "m.toml"));
+    ADD_FAILURE() << "mixed separation methods were accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("every interaction of a scene must use the same "
+                                         "separation method"),
+              std::string::npos)
+        << e.what();
+  }
+  const Scene scene = parse_scene_text(
+      with_third("separation = \"extrapolated\"\n", "separation = \"extrapolated\"\n"), "m.toml");
+  EXPECT_EQ(scene.interactions[0].separation, Separation::extrapolated);
+  const FieldPlan plan = plan_fields(scene);
+  EXPECT_TRUE(plan.extrapolated_separation);
+  EXPECT_FALSE(plan.position_separation);
 }
 
 }  // namespace

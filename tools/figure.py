@@ -502,7 +502,8 @@ KI, KM, GM = an.paper_csa_moduli()
 PHI = math.pi / 6 * 0.7 ** 3
 
 
-def cube_sets(h, ppc=2, scale=1.0, force_limit=True, cfl=None, end_time=0.015, integration="explicit"):
+def cube_sets(h, ppc=2, scale=1.0, force_limit=True, cfl=None, end_time=0.015, integration="explicit",
+              separation="displacement"):
     """Overrides for inputs/sphere_in_cube.toml; `scale` shrinks every length (and time)."""
     s = scale
     n = int(round(1.3 / h))
@@ -510,7 +511,8 @@ def cube_sets(h, ppc=2, scale=1.0, force_limit=True, cfl=None, end_time=0.015, i
            f"grid.cells=[{n},{n},{n}]", f"body[0].particles_per_cell={ppc}",
            f"body[1].particles_per_cell={ppc}",
            f"interaction[0].force_limit={'true' if force_limit else 'false'}",
-           f'interaction[0].integration="{integration}"', f"simulation.end_time={fmt(end_time * s)}"]
+           f'interaction[0].integration="{integration}"', f"simulation.end_time={fmt(end_time * s)}",
+           f'interaction[0].separation="{separation}"']
     if cfl:
         out.append(f"simulation.cfl={fmt(cfl)}")
     if s != 1.0:
@@ -620,6 +622,9 @@ def fig12(runner, quick, outdir):
         series += cube_series("h050_nolimit", inv, "50 $\\mu$m (no force limits)", [], h=0.05, force_limit=False)
         series += cube_series("h100_exact", inv, "100 $\\mu$m, exact integration", [], h=0.1,
                               integration="exact")
+        # docs/interface_validation.md, "Extrapolated separation" (2 ppc: 1 ppc is unstable with it)
+        series += cube_series("h100_extrapolated", inv, "100 $\\mu$m, extrapolated separation", [], h=0.1,
+                              separation="extrapolated")
     plot_cube("fig12", runner, outdir, series, "energy", "Fig. 12: K from energy, r = 700 $\\mu$m, "
               "Vf = 17.96 %, Dn = Dt")
 

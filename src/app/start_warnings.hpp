@@ -1,7 +1,8 @@
 // The scene warnings `check` and `run` print before a fresh start, one line
 // each, in one order: USL above its measured step limit, interfaces too
 // stiff for the step without the force limit, contact pairs that start
-// apart under the displacement separation.
+// apart under the displacement separation, the extrapolated separation
+// with 1 particle per cell.
 #pragma once
 
 #include <string>

@@ -59,8 +59,10 @@ inline constexpr std::array<EnumName<NormalMethod>, 5> kNormalMethodNames{
      {"specified", NormalMethod::specified},
      {"radial", NormalMethod::radial},
      {"rigid", NormalMethod::rigid}}};
-inline constexpr std::array<EnumName<Separation>, 2> kSeparationNames{
-    {{"displacement", Separation::displacement}, {"position", Separation::position}}};
+inline constexpr std::array<EnumName<Separation>, 3> kSeparationNames{
+    {{"displacement", Separation::displacement},
+     {"position", Separation::position},
+     {"extrapolated", Separation::extrapolated}}};
 inline constexpr std::array<EnumName<Integration>, 2> kIntegrationNames{
     {{"explicit", Integration::explicit_}, {"exact", Integration::exact}}};
 inline constexpr std::array<EnumName<TractionLaw>, 2> kTractionLawNames{

@@ -22,7 +22,9 @@ enum class MaterialType { isotropic, transverse, neohookean, rigid };
 enum class BodyShape { box, disk, sphere, cylinder, polygon };
 enum class Law { stick, frictionless, friction, interface, separate };
 enum class NormalMethod { mvg, avg, specified, radial, rigid };
-enum class Separation { displacement, position };
+// extrapolated: displacement at the node, not at the centroid
+// (kernels/separation_extrapolation.hpp)
+enum class Separation { displacement, position, extrapolated };
 enum class Integration { explicit_, exact };
 enum class TractionLaw { linear, bilinear };  // bilinear: stiff in compression (ALGORITHM §3.2)
 enum class LoadKind { traction, gravity };

@@ -46,15 +46,17 @@ FieldPlan plan_fields(const Scene& scene) {
   if (!plan.multimaterial) return plan;
 
   // Separation method: one for the whole scene (mx holds one kind of data).
+  Separation method = Separation::displacement;
   bool any = false;
   for (const auto& it : scene.interactions) {
-    const bool pos = it.separation == Separation::position;
-    if (any && pos != plan.position_separation)
+    if (any && it.separation != method)
       throw InputError(located(it.where.file, it.where.line, "separation",
                                "every interaction of a scene must use the same separation method"));
-    plan.position_separation = pos;
+    method = it.separation;
     any = true;
   }
+  plan.position_separation = method == Separation::position;
+  plan.extrapolated_separation = method == Separation::extrapolated;
   for (const auto& it : scene.interactions) {
     const int a = plan.field_of_material[std::size_t(scene.material_index(it.materials[0]))];
     const int b = plan.field_of_material[std::size_t(scene.material_index(it.materials[1]))];
@@ -72,7 +74,7 @@ FieldPlan plan_fields(const Scene& scene) {
       if (default_law < 0) {
         InteractionSpec d;
         d.law = scene.simulation.default_law;
-        d.separation = plan.position_separation ? Separation::position : Separation::displacement;
+        d.separation = method;
         d.normal = NormalMethod::mvg;
         d.materials = {"*", "*"};
         default_law = int(plan.laws.size());

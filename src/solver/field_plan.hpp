@@ -12,13 +12,14 @@ namespace mmpm {
 
 struct FieldPlan {
   int fields = 1;
-  std::vector<int> field_of_material;  // per material
-  std::vector<unsigned char> rigid;    // per field
-  std::vector<int> rigid_material;     // per field: material index, or -1
-  std::vector<InteractionSpec> laws;   // the distinct interactions in use
-  std::vector<int> pair;               // fields x fields → index into laws, -1 = none
-  bool multimaterial = false;          // a multimaterial pass exists
-  bool position_separation = false;    // mx holds positions (else displacements)
+  std::vector<int> field_of_material;    // per material
+  std::vector<unsigned char> rigid;      // per field
+  std::vector<int> rigid_material;       // per field: material index, or -1
+  std::vector<InteractionSpec> laws;     // the distinct interactions in use
+  std::vector<int> pair;                 // fields x fields → index into laws, -1 = none
+  bool multimaterial = false;            // a multimaterial pass exists
+  bool position_separation = false;      // mx holds positions (else displacements)
+  bool extrapolated_separation = false;  // mx moved from the centroid to the node
 };
 
 FieldPlan plan_fields(const Scene& scene);

@@ -76,6 +76,7 @@ class MultimaterialStage {
     find_multimaterial_nodes(grid, cfg_.mass_threshold, list_, own, mixed);
   }
   const std::vector<std::uint32_t>& nodes() const { return list_; }
+  Real mass_threshold() const { return cfg_.mass_threshold; }
 
   // After find_nodes and the multimaterial fields' P2G.
   // limit_dt: the step the stick decisions are made for (MMConfig::limit_dt;

@@ -26,6 +26,7 @@
 #include "kernels/p2g.hpp"
 #include "kernels/p2g_multimaterial.hpp"
 #include "kernels/reduce.hpp"
+#include "kernels/separation_extrapolation.hpp"
 #include "kernels/shape.hpp"
 #include "kernels/supports.hpp"
 #include "model/bodies.hpp"
@@ -212,6 +213,7 @@ class Stepper final : public Simulation {
   std::vector<std::uint8_t> scratch_bytes_;
   ParticleView<D, Real> P_;
   GridView<D, Real> G_;
+  SeparationMoments<D, Real> moments_;  // separation = "extrapolated" only
   GridVelocity<D, Real> GV_;
   std::vector<Real> scratch_;
   // The velocity gradient of every particle (gradient_and_stress),

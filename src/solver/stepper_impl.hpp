@@ -60,6 +60,16 @@ void Stepper<D, Shape, Real>::setup_grid() {
       if (domain_gradient_) G_.g[d] = gcols_.add_real(std::string("g") + axis[d], n);
       G_.fi[d] = gcols_.add_real(std::string("fi") + axis[d], n);
     }
+    if (plan_.extrapolated_separation) {
+      for (int a = 0; a < D; ++a) {
+        moments_.r[a] = gcols_.add_real(std::string("sep_r") + axis[a], n);
+        for (int c = 0; c < D; ++c)
+          moments_.ur[std::size_t(a * D + c)] =
+              gcols_.add_real(std::string("sep_u") + axis[a] + axis[c], n);
+      }
+      for (int k = 0; k < moments_.kSym; ++k)
+        moments_.rr[std::size_t(k)] = gcols_.add_real("sep_rr" + std::to_string(k), n);
+    }
   }
   // Tile edge: the largest of 64, 32, 16, 8, 4 in 2D (8, 4 in 3D) that
   // leaves every color at least 32 tiles. A thread's share of a color is
@@ -550,11 +560,18 @@ void Stepper<D, Shape, Real>::p2g_multimaterial() {
   const bool scattered = mm_fields_with_p2g_;
   mm_fields_scattered_with_p2g_ = scattered;
   mm_fields_with_p2g_ = double(reaching) > scene_.simulation.mm_fields_share * double(P_.n);
-  if (scattered) return;
-  const P2GOptions opt = p2g_options();
-  const std::size_t bad = p2g_multimaterial_fields<D, Shape, Real>(
-      P_, G_, opt, tiles_, schedule_, reach_tiles_, domain_gradient_, P_.n >= kParallelMin);
-  if (bad != SIZE_MAX) fail_particle("p2g", bad, "its shape-function stencil left the grid");
+  if (!scattered) {
+    const P2GOptions opt = p2g_options();
+    const std::size_t bad = p2g_multimaterial_fields<D, Shape, Real>(
+        P_, G_, opt, tiles_, schedule_, reach_tiles_, domain_gradient_, P_.n >= kParallelMin);
+    if (bad != SIZE_MAX) fail_particle("p2g", bad, "its shape-function stencil left the grid");
+  }
+  if (moments_.enabled()) {  // separation = "extrapolated": mx from the centroids to the nodes
+    const std::size_t bad = extrapolate_separation<D, Shape, Real>(
+        P_, G_, moments_, tiles_, schedule_, reach_tiles_, mm_.nodes(), plan_.rigid.data(),
+        mm_.mass_threshold(), P_.n >= kParallelMin);
+    if (bad != SIZE_MAX) fail_particle("p2g", bad, "its shape-function stencil left the grid");
+  }
 }
 
 template <int D, class Shape, class Real>
