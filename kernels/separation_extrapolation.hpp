@@ -32,8 +32,10 @@
 //
 // The moments are scattered like mx (kernels/p2g_multimaterial.hpp): only by
 // the tiles that reach a multimaterial node, color by color, so the sums and
-// their order do not depend on the thread count. mx is corrected in place at
-// the multimaterial nodes, each node on its own.
+// their order do not depend on the thread count; and only by the particles
+// whose stencil holds a multimaterial node, into those nodes alone (a tile
+// is up to 64 cells wide, an interface's nodes 2-4). mx is corrected in
+// place at the multimaterial nodes, each node on its own.
 #pragma once
 
 #include <algorithm>
@@ -89,12 +91,17 @@ constexpr int sym_index(int a, int b) {
 // stencil left the grid, or SIZE_MAX.
 template <int D, class Shape, class Real>
 std::size_t scatter_moments(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
-                            const SeparationMoments<D, Real>& M, std::size_t b, std::size_t e) {
+                            const SeparationMoments<D, Real>& M, const std::uint8_t* listed,
+                            std::size_t b, std::size_t e) {
   const std::array<Real, 3> inv_h{Real(1) / G.h[0], Real(1) / G.h[1], Real(1) / G.h[2]};
   const std::size_t nx = std::size_t(G.nodes_per_dim[0]), ny = std::size_t(G.nodes_per_dim[1]);
   Stencil<D, Shape, Real> st{};
   for (std::size_t p = b; p < e; ++p) {
     if (!st.build(P, G, inv_h, p)) return p;
+    // Most particles of a reaching tile reach no multimaterial node: skip them.
+    bool reaches = false;
+    for (int k = 0; k < st.count; ++k) reaches |= listed[st.base + st.node[k]] != 0;
+    if (!reaches) continue;
     const std::size_t fo = std::size_t(P.field[p]) * G.nodes;
     const Real mp = P.m[p];
     Real xi[D], u[D];
@@ -109,9 +116,9 @@ std::size_t scatter_moments(const ParticleView<D, Real>& P, const GridView<D, Re
     constexpr int S = Shape::S;
     for (int k = 0; k < st.count; ++k) {
       const Real w = st.w[k] * mp;
+      if (w == Real(0) || !listed[st.base + st.node[k]]) continue;  // only listed nodes are read
       const std::size_t i = fo + st.base + st.node[k];
-      // An emptied node (a mirror's ghost layer) is never a multimaterial node.
-      if (w == Real(0) || !(G.m[i] > Real(0))) continue;
+      if (!(G.m[i] > Real(0))) continue;
       const int offset[3] = {k % S, (k / S) % S, k / (S * S)};
       Real r[D], du[D];
       for (int d = 0; d < D; ++d) {
@@ -211,32 +218,34 @@ void correct_node(const GridView<D, Real>& G, const SeparationMoments<D, Real>& 
 // first particle whose stencil left the grid, or SIZE_MAX.
 template <int D, class Shape, class Real>
 std::size_t extrapolate_separation(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
-                                   const SeparationMoments<D, Real>& M, const TileLayout<D>& layout,
+                                   const SeparationMoments<D, Real>& M,
                                    const TileSchedule& schedule, const ReachTiles& reach_tiles,
                                    const std::vector<std::uint32_t>& nodes,
-                                   const unsigned char* rigid, Real mass_threshold, bool parallel) {
-  const NodeReach reach = NodeReach::of<Shape>();
+                                   const unsigned char* rigid, Real mass_threshold,
+                                   std::vector<std::uint8_t>& listed, bool parallel) {
   constexpr int kSym = SeparationMoments<D, Real>::kSym;
-  for (const auto& list : reach_tiles.tiles) {
+  // Flags of the listed nodes (all zero between calls; sized once), and their
+  // moments zeroed: nothing reads the moments anywhere else.
+  if (listed.size() != G.nodes) listed.assign(G.nodes, 0);
+  for (const std::uint32_t n : nodes) listed[n] = 1;
 #pragma omp parallel for schedule(static) if (parallel)
-    for (std::size_t k = 0; k < list.size(); ++k) {
-      const NodeBox box =
-          tile_node_box(layout, layout.tile_of_slot(list[k]), G.nodes_per_dim, reach);
-      for (int a = 0; a < D; ++a) zero_node_box<D>(M.r[a], G.nodes, G.fields, G.nodes_per_dim, box);
-      for (int a = 0; a < kSym; ++a)
-        zero_node_box<D>(M.rr[std::size_t(a)], G.nodes, G.fields, G.nodes_per_dim, box);
-      for (int a = 0; a < D * D; ++a)
-        zero_node_box<D>(M.ur[std::size_t(a)], G.nodes, G.fields, G.nodes_per_dim, box);
+  for (std::size_t k = 0; k < nodes.size(); ++k)
+    for (int f = 0; f < G.fields; ++f) {
+      const std::size_t i = G.at(f, nodes[k]);
+      for (int a = 0; a < D; ++a) M.r[a][i] = Real(0);
+      for (int a = 0; a < kSym; ++a) M.rr[std::size_t(a)][i] = Real(0);
+      for (int a = 0; a < D * D; ++a) M.ur[std::size_t(a)][i] = Real(0);
     }
-  }
   std::size_t bad = SIZE_MAX;
   for (const auto& list : reach_tiles.tiles) {
 #pragma omp parallel for schedule(static) reduction(min : bad) if (parallel)
     for (std::size_t k = 0; k < list.size(); ++k) {
       const std::size_t b = schedule.begin[list[k]], e = schedule.begin[list[k] + 1];
-      bad = std::min(bad, separation_detail::scatter_moments<D, Shape, Real>(P, G, M, b, e));
+      bad = std::min(
+          bad, separation_detail::scatter_moments<D, Shape, Real>(P, G, M, listed.data(), b, e));
     }
   }
+  for (const std::uint32_t n : nodes) listed[n] = 0;
   if (bad != SIZE_MAX) return bad;
 #pragma omp parallel for schedule(static) if (parallel)
   for (std::size_t k = 0; k < nodes.size(); ++k)

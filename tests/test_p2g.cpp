@@ -672,9 +672,11 @@ void check_extrapolated_separation(unsigned seed) {
     for (int a = 0; a < M.kSym; ++a) M.rr[std::size_t(a)] = store[k++].data();
     for (int a = 0; a < D * D; ++a) M.ur[std::size_t(a)] = store[k++].data();
     omp_set_num_threads(threads);
-    EXPECT_EQ((extrapolate_separation<D, Shape, Real>(P, g->G, M, tiles, r, rt, nodes, nullptr,
-                                                      Real(0), threads == 2)),
+    std::vector<std::uint8_t> listed;
+    EXPECT_EQ((extrapolate_separation<D, Shape, Real>(P, g->G, M, r, rt, nodes, nullptr, Real(0),
+                                                      listed, threads == 2)),
               SIZE_MAX);
+    EXPECT_EQ(std::count(listed.begin(), listed.end(), std::uint8_t(1)), 0) << "flags left set";
     ++threads;
   }
   omp_set_num_threads(2);

@@ -213,7 +213,8 @@ class Stepper final : public Simulation {
   std::vector<std::uint8_t> scratch_bytes_;
   ParticleView<D, Real> P_;
   GridView<D, Real> G_;
-  SeparationMoments<D, Real> moments_;  // separation = "extrapolated" only
+  SeparationMoments<D, Real> moments_;           // separation = "extrapolated" only
+  std::vector<std::uint8_t> separation_listed_;  // its node flags (zero between steps)
   GridVelocity<D, Real> GV_;
   std::vector<Real> scratch_;
   // The velocity gradient of every particle (gradient_and_stress),

@@ -568,8 +568,8 @@ void Stepper<D, Shape, Real>::p2g_multimaterial() {
   }
   if (moments_.enabled()) {  // separation = "extrapolated": mx from the centroids to the nodes
     const std::size_t bad = extrapolate_separation<D, Shape, Real>(
-        P_, G_, moments_, tiles_, schedule_, reach_tiles_, mm_.nodes(), plan_.rigid.data(),
-        mm_.mass_threshold(), P_.n >= kParallelMin);
+        P_, G_, moments_, schedule_, reach_tiles_, mm_.nodes(), plan_.rigid.data(),
+        mm_.mass_threshold(), separation_listed_, P_.n >= kParallelMin);
     if (bad != SIZE_MAX) fail_particle("p2g", bad, "its shape-function stencil left the grid");
   }
 }
