@@ -48,7 +48,6 @@
 #include "kernels/binning.hpp"
 #include "kernels/p2g_multimaterial.hpp"
 #include "kernels/position_sum.hpp"
-#include "kernels/tile_reach.hpp"
 #include "kernels/weights.hpp"
 
 namespace mmpm {

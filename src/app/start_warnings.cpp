@@ -2,6 +2,7 @@
 
 #include <sstream>
 
+#include "scene/interaction_warning.hpp"
 #include "solver/contact_gap.hpp"
 #include "solver/simulation.hpp"
 
@@ -22,8 +23,8 @@ std::vector<std::string> extrapolated_separation_warnings(const Scene& scene) {
           (b.material != it.materials[0] && b.material != it.materials[1]))
         continue;
       std::ostringstream m;
-      m << it.where.file << ":" << it.where.line << ": warning: key 'interaction[" << k
-        << "].separation': \"extrapolated\" needs 2 or more particles per cell per direction; "
+      m << interaction_warning(scene, k, "separation")
+        << "\"extrapolated\" needs 2 or more particles per cell per direction; "
         << "body '" << b.name << "' has " << b.particles_per_cell
         << " (a sphere in a cube seeded 1 per cell blew up at D = 1e6 MPa/mm where "
         << "\"displacement\" only crept)";

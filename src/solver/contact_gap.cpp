@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "scene/format.hpp"
+#include "scene/interaction_warning.hpp"
 #include "solver/field_plan.hpp"
 #include "solver/simulation.hpp"
 
@@ -177,9 +178,7 @@ std::string open_contact_warning(const Scene& scene, const FieldPlan& plan, cons
   const std::size_t l = std::size_t(c.law);
   if (l < scene.interactions.size()) {  // plan.laws starts with the scene's interactions
     const InteractionSpec& it = scene.interactions[l];
-    m << (it.where.file.empty() ? scene.source_file : it.where.file);
-    if (it.where.line > 0) m << ":" << it.where.line;
-    m << ": warning: key 'interaction[" << l << "].separation': materials '" << it.materials[0]
+    m << interaction_warning(scene, l, "separation") << "materials '" << it.materials[0]
       << "' and '" << it.materials[1] << "' start apart";
   } else {
     m << scene.source_file << ": warning: key 'simulation.default_law' ("

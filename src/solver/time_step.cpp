@@ -8,6 +8,7 @@
 
 #include "model/material.hpp"
 #include "scene/error.hpp"
+#include "scene/interaction_warning.hpp"
 #include "solver/simulation.hpp"
 
 namespace mmpm {
@@ -135,10 +136,8 @@ std::vector<std::string> stiff_interface_warnings(const Scene& scene, double dt)
     const double bound = 4 / (dt * dt) * hmin / (2 * inverse_density);
     std::ostringstream m;
     m.precision(3);
-    m << (it.where.file.empty() ? scene.source_file : it.where.file);
-    if (it.where.line > 0) m << ":" << it.where.line;
-    m << ": warning: key 'interaction[" << i << "]." << key << "': with force_limit = false, "
-      << key << " = " << D << " is stiffer than this time step integrates: omega dt = " << omega_dt
+    m << interaction_warning(scene, i, key) << "with force_limit = false, " << key << " = " << D
+      << " is stiffer than this time step integrates: omega dt = " << omega_dt
       << " at a node the interface halves (explicit integration needs < 2, so " << key
       << " below about " << bound
       << "). Expect the run to go unstable; use force_limit = true (the paper's clip), "
