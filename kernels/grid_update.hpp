@@ -33,6 +33,11 @@ struct GridUpdateParams {
   // USL only (0 otherwise): at nodes whose mass is at most this, vel leaves
   // out the force increment (light_node_velocity below).
   double light_threshold = 0;
+  // With velocities: false when nothing reads p after this pass (the
+  // single-field step: G2P reads vel and dvel, MUSL zeroes p for its second
+  // scatter, the next step's P2G starts from zero), so the updated momentum
+  // is not stored: 3 of the 3D pass's 16 arrays (2 of 11 in 2D).
+  bool keep_momentum = true;
 };
 
 // USL's velocity gradient reads the grid velocity after the momentum
@@ -87,7 +92,7 @@ namespace detail {
 // against 1.2 in 3D (docs/performance.md "The grid stage on two threads");
 // out of line it vectorises in every unit, and tools/check_vectorised.py
 // sees every copy.
-template <int D, class Real, bool Interface, bool Damping, bool Velocities>
+template <int D, class Real, bool Interface, bool Damping, bool Velocities, bool KeepP = true>
 [[gnu::noinline]] void update_deformable(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
                                          std::size_t o, std::size_t b, std::size_t e, Real dt,
                                          Real alpha, Real thr, Real light, const Real (&gacc)[D],
@@ -142,7 +147,7 @@ template <int D, class Real, bool Interface, bool Damping, bool Velocities>
       } else {
         dv_[d][n] = heavy ? -p * inv_m : sliver;
       }
-      p_[d][n] = heavy ? updated : p;
+      if constexpr (KeepP) p_[d][n] = heavy ? updated : p;
       sum = std::fma(double(p) * double(p), double(inv_m), sum);
     }
     if constexpr (Damping) pv[n - b] = heavy ? sum : 0.0;
@@ -195,9 +200,12 @@ double grid_update(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
     double pv[kReduceChunk];
     const bool damping = q.damping != 0;
     auto run = [&]<bool I, bool Dmp>() {
-      if (q.velocities)
+      if (q.velocities && q.keep_momentum)
         detail::update_deformable<D, Real, I, Dmp, true>(G, V, o, b, e, dt, alpha, thr, light, gacc,
                                                          pv);
+      else if (q.velocities)
+        detail::update_deformable<D, Real, I, Dmp, true, false>(G, V, o, b, e, dt, alpha, thr,
+                                                                light, gacc, pv);
       else
         detail::update_deformable<D, Real, I, Dmp, false>(G, V, o, b, e, dt, alpha, thr, light,
                                                           gacc, pv);

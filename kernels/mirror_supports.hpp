@@ -20,8 +20,15 @@
 // velocity change there (a mirrored half bar differed from the whole bar by
 // 1e-3 in the first row's velocity; with it, by 2e-16).
 //
-// Serial loops over a plane's nodes: a few hundred to a few thousand nodes
-// per step, with partners that can lie in the other thread's range.
+// Each thread folds the entries whose partner it owns and sets the ghosts
+// it owns (the node ranges of kernels/node_ownership.hpp), so the lines the
+// next node loop reads stay in the cache of the core that reads them. Done
+// by thread 0 alone, the 3D block of bench_step (a plane of 783 nodes)
+// spent 96 us per step in these loops on 2 threads against 51 on one: half
+// of every entry's lines sat in the other core's cache
+// (docs/performance.md "Mirror folds on the nodes a thread owns"). An
+// entry's result does not depend on which thread runs it, and the
+// reactions are summed afterwards in entry order (fold_reaction).
 #pragma once
 
 #include <cstddef>
@@ -48,20 +55,22 @@ struct MirrorView {
 enum MirrorFold : unsigned { kFoldMass = 1, kFoldMomentum = 2, kFoldForce = 4 };
 
 // Folds field f's ghost values into their partners and empties the ghosts;
-// sets the plane nodes' fixed components to the support's. The image of a
+// sets the plane nodes' fixed components to the support's. Only the entries
+// whose partner lies in [first, last) (a thread's own nodes). The image of a
 // ghost's momentum about the moving plane is 2 m_g v_s - p_g on the fixed
-// components. With reaction (D entries): adds the force the image exerts on
-// the body's nodes along the fixed components, -f_0 on a plane node and
-// -2 f_g per ghost (the ghost's force leaves, its negative arrives at the
-// partner). The momentum folds are left out of it: they project the
-// velocities onto symmetric ones rather than act over the step, and as
-// impulses over dt they read 49 instead of -1 in a static bar's last,
-// 1e-9 ms short step.
+// components. With terms (count x D entries): entry k's f_0 + 2 f_g along
+// the fixed components, whose negative is the force the image exerts on the
+// body's nodes (the ghost's force leaves, its negative arrives at the
+// partner); fold_reaction sums them. The momentum folds are left out of it:
+// they project the velocities onto symmetric ones rather than act over the
+// step, and as impulses over dt they read 49 instead of -1 in a static
+// bar's last, 1e-9 ms short step.
 template <int D, class Real>
 void fold_mirror(const GridView<D, Real>& G, const MirrorView<Real>& M, int f, unsigned what,
-                 double* reaction) {
+                 double* terms, std::size_t first, std::size_t last) {
   const std::size_t o = std::size_t(f) * G.nodes;
   for (std::size_t k = 0; k < M.count; ++k) {
+    if (M.partner[k] < first || M.partner[k] >= last) continue;
     const std::size_t g = o + M.ghost[k], q = o + M.partner[k], c = o + M.plane[k];
     Real& m_g = M.ghost_mass[std::size_t(f) * M.count + k];
     if (what & kFoldMass) {
@@ -76,7 +85,7 @@ void fold_mirror(const GridView<D, Real>& G, const MirrorView<Real>& M, int f, u
         if (M.fix[d]) G.p[d][c] = G.m[c] * M.velocity[d];
       }
       if (what & kFoldForce) {
-        if (reaction && M.fix[d]) reaction[d] -= double(G.f[d][c]) + 2.0 * double(G.f[d][g]);
+        if (terms && M.fix[d]) terms[k * D + d] = double(G.f[d][c]) + 2.0 * double(G.f[d][g]);
         G.f[d][q] += M.fix[d] ? -G.f[d][g] : G.f[d][g];
         G.f[d][g] = Real(0);
         if (M.fix[d]) G.f[d][c] = Real(0);
@@ -85,15 +94,29 @@ void fold_mirror(const GridView<D, Real>& G, const MirrorView<Real>& M, int f, u
   }
 }
 
+// Adds to reaction (D entries) the force the image exerted on the body in
+// fold_mirror's force fold, from its terms (count x D), in entry order: the
+// bits of the serial loop that accumulated them as it folded.
+template <int D, class Real>
+void fold_reaction(const MirrorView<Real>& M, const double* terms, double* reaction) {
+  for (std::size_t k = 0; k < M.count; ++k)
+    for (int d = 0; d < D; ++d)
+      if (M.fix[d]) reaction[d] -= terms[k * D + d];
+}
+
 // The ghosts' velocities from their partners': v_g = 2 v_s - v_q on the
 // fixed components (v_s the support's velocity: the odd image about the
 // moving plane), v_g = v_q on the free ones; the changes over the step
 // likewise, -dv_q and dv_q.
+// Only the ghosts in [first, last) (a thread's own nodes), once every
+// partner's velocity is final.
 template <int D, class Real>
 void mirror_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
-                       const MirrorView<Real>& M, int f, bool with_dvel) {
+                       const MirrorView<Real>& M, int f, bool with_dvel, std::size_t first,
+                       std::size_t last) {
   const std::size_t o = std::size_t(f) * G.nodes;
   for (std::size_t k = 0; k < M.count; ++k) {
+    if (M.ghost[k] < first || M.ghost[k] >= last) continue;
     const std::size_t g = o + M.ghost[k], q = o + M.partner[k];
     for (int d = 0; d < D; ++d) {
       const bool odd = M.fix[d];

@@ -271,6 +271,7 @@ class Stepper final : public Simulation {
     std::vector<std::uint32_t> ghost, partner;
     std::vector<Real> ghost_mass;             // fields x ghosts (MirrorView::ghost_mass)
     std::array<double, 3> reaction{0, 0, 0};  // this step's folds (fold_mirror)
+    std::vector<double> fold_terms;           // fields x ghosts x D (fold_mirror's terms)
   };
   std::vector<MirrorPlane> mirrors_;
 

@@ -756,6 +756,7 @@ void Stepper<D, Shape, Real>::grid_update_stage() {
   // Without pass B nothing changes p before the velocities: one pass, which
   // also applies the supports.
   q.velocities = !plan_.multimaterial;
+  q.keep_momentum = !q.velocities;  // the velocity pass is the last to read p
   if (q.velocities) {
     const Supports<Real> s = supports(true);
     damping_loss_ += grid_update(G_, GV_, q, own_, [&](int f, std::size_t b, std::size_t e) {
@@ -884,25 +885,58 @@ MirrorView<Real> Stepper<D, Shape, Real>::mirror_view(MirrorPlane& mp) const {
   return v;
 }
 
+// Each thread folds the entries whose partner it owns
+// (kernels/mirror_supports.hpp), one mirror after the other: where two meet,
+// the second folds what the first left at the corner.
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::fold_mirrors(unsigned what, bool with_reaction) {
+  const bool reaction = with_reaction && (what & kFoldForce);
+  for (MirrorPlane& mp : mirrors_)
+    if (reaction) mp.fold_terms.resize(mp.ghost.size() * std::size_t(G_.fields * D));
+#pragma omp parallel if (G_.nodes * std::size_t(G_.fields) >= kParallelMin)
+  {
+    const auto [first, last] = own_.mine(G_.nodes);
+    for (std::size_t i = 0; i < mirrors_.size(); ++i) {
+      if (i > 0) {
+#pragma omp barrier
+      }
+      MirrorPlane& mp = mirrors_[i];
+      const MirrorView<Real> v = mirror_view(mp);
+      for (int f = 0; f < G_.fields; ++f)
+        if (!plan_.rigid[std::size_t(f)])
+          fold_mirror(G_, v, f, what,
+                      reaction ? mp.fold_terms.data() + std::size_t(f) * v.count * D : nullptr,
+                      first, last);
+    }
+  }
+  if (!reaction) return;
   for (MirrorPlane& mp : mirrors_) {
     const MirrorView<Real> v = mirror_view(mp);
     for (int f = 0; f < G_.fields; ++f)
       if (!plan_.rigid[std::size_t(f)])
-        fold_mirror(G_, v, f, what, with_reaction ? mp.reaction.data() : nullptr);
+        fold_reaction<D>(v, mp.fold_terms.data() + std::size_t(f) * v.count * D,
+                         mp.reaction.data());
   }
 }
 
 // In the reverse order of the folds: where two mirrors meet, the ghost of
 // the first (folded first) at the corner takes its velocity from a node in
-// the second's ghost layer, which the second has just set.
+// the second's ghost layer, which the second has just set. Each thread sets
+// the ghosts it owns.
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::mirror_ghost_velocities(bool with_dvel) {
-  for (auto it = mirrors_.rbegin(); it != mirrors_.rend(); ++it) {
-    const MirrorView<Real> v = mirror_view(*it);
-    for (int f = 0; f < G_.fields; ++f)
-      if (!plan_.rigid[std::size_t(f)]) mirror_velocities(G_, GV_, v, f, with_dvel);
+  if (mirrors_.empty()) return;
+#pragma omp parallel if (G_.nodes * std::size_t(G_.fields) >= kParallelMin)
+  {
+    const auto [first, last] = own_.mine(G_.nodes);
+    for (std::size_t i = mirrors_.size(); i-- > 0;) {
+      if (i + 1 < mirrors_.size()) {
+#pragma omp barrier
+      }
+      const MirrorView<Real> v = mirror_view(mirrors_[i]);
+      for (int f = 0; f < G_.fields; ++f)
+        if (!plan_.rigid[std::size_t(f)]) mirror_velocities(G_, GV_, v, f, with_dvel, first, last);
+    }
   }
 }
 
@@ -1056,8 +1090,10 @@ void Stepper<D, Shape, Real>::step() {
     toc_time(kStageP2G);
   }
   tic();
-  // The forces added since the first fold (USF's P2G, the loads).
-  if (!mirrors_.empty()) fold_mirrors(kFoldForce, true);
+  // The forces added since the first fold (USF's P2G, the loads); without
+  // them the fold would only move the zeros the first one left.
+  if (!mirrors_.empty() && (scheme == Scheme::USF || has_traction_))
+    fold_mirrors(kFoldForce, true);
   grid_update_stage();
   toc(kStageGrid);
   if (mm) {
