@@ -538,6 +538,31 @@ TEST(Cli, ExtrapolatedSeparationWithOneParticlePerCellWarns) {
   EXPECT_EQ(two.err, "") << two.describe();
 }
 
+// An interface between bodies that start bonded, with separation =
+// "position": the centroids' offset loads it from the first step (two_layer
+// with Dn = 1000 made 5.2 mJ from 0.0019 mJ of work in 0.01 ms), so `check`
+// warns, naming the interaction's line; the default (displacement) does not,
+// nor position on bodies that start apart (collision.toml's own scene).
+TEST(Cli, PositionSeparationOnABondedInterfaceWarns) {
+  const std::string scene = source_dir() + "/inputs/two_layer.toml";
+  const CmdResult bonded =
+      run_mmpm({"check", scene, "--set", "interaction[0].separation=\"position\"", "--set",
+                "interaction[0].Dn=1000.0"});
+  ASSERT_EQ(bonded.exit_code, 0) << bonded.describe();
+  const auto lines = lines_of(bonded.err);
+  ASSERT_EQ(lines.size(), 1u) << bonded.describe();
+  const std::string where =
+      scene + ":" + std::to_string(line_of(read_text(scene), "[[interaction]]")) + ":";
+  EXPECT_TRUE(contains(lines[0], where + " warning: key 'interaction[0].separation'")) << lines[0];
+  EXPECT_TRUE(contains(lines[0], "start bonded")) << lines[0];
+  const CmdResult apart =
+      run_mmpm({"check", source_dir() + "/inputs/collision.toml", "--set",
+                "interaction[0].law=\"interface\"", "--set", "interaction[0].Dn=1000.0", "--set",
+                "interaction[0].Dt=1000.0"});
+  EXPECT_EQ(apart.exit_code, 0) << apart.describe();
+  EXPECT_EQ(apart.err, "") << apart.describe();
+}
+
 // Pairs without an [[interaction]] of their own fall back on [simulation]
 // default_law (stick unless set): the same check applies to them. A third
 // material, named in no interaction, lies 1 mm above both blocks of
@@ -598,29 +623,35 @@ particles_per_cell = 2
   EXPECT_TRUE(contains(one_lines[0], "'strip' and 'block_b'")) << one_lines[0];
 }
 
-// scheme = "USL" is stable to about cfl = 0.75 (docs/validation.md §3.5:
-// 2D and 3D bars run at 0.75 and blow up at 0.78-0.8): check and run warn
-// above it, once, at the key that set the step, and still run (run refuses
-// only cfl > 1). MUSL at the same cfl, and USL below the limit, say nothing.
+// scheme = "USL" has a step limit per shape (docs/validation.md §3.5: 0.55
+// with uGIMP; the bars grow at 0.6 on a support): check and run warn above
+// it, once, at the key that set the step, and still run (run refuses only
+// cfl > 1; the run here ends after 6 steps, before the mode has grown).
+// MUSL at the same cfl, and USL at the limit, say nothing.
 TEST(Cli, UslAboveItsLimitWarns) {
   const std::string usl = "simulation.scheme=\"USL\"";
   for (const char* command : {"check", "run"}) {
     TempDir tmp;
     std::vector<std::string> args = {
         command, bar_scene(),          "--set", usl,
-        "--set", "simulation.cfl=0.9", "--set", "simulation.end_time=0.002"};
+        "--set", "simulation.cfl=0.9", "--set", "simulation.end_time=0.0005"};
     if (std::string(command) == "run") args.insert(args.end(), {"--out", (tmp / "o").string()});
     const CmdResult fast = run_mmpm(args);
     ASSERT_EQ(fast.exit_code, 0) << fast.describe();
     const auto lines = lines_of(fast.err);
     ASSERT_EQ(lines.size(), 1u) << fast.describe();
     EXPECT_TRUE(contains(lines[0], bar_scene() + ": warning: key 'simulation.cfl': scheme \"USL\" "
-                                                 "is stable only to about cfl = 0.75 (measured)"))
+                                                 "with shape \"gimp\" is stable only to about "
+                                                 "cfl = 0.55 (measured)"))
         << lines[0];
     EXPECT_TRUE(contains(lines[0], "this step is cfl 0.9")) << lines[0];
   }
+  // The limit is the shape's (docs/validation.md §3.5): cubic B-splines ran
+  // the bar stable at 1.0, so 0.9 is quiet for them.
   for (const std::vector<std::string>& sets :
-       {std::vector<std::string>{"--set", usl, "--set", "simulation.cfl=0.75"},
+       {std::vector<std::string>{"--set", usl, "--set", "simulation.cfl=0.55"},
+        std::vector<std::string>{"--set", usl, "--set", "simulation.cfl=0.9", "--set",
+                                 "grid.shape=\"bspline3\""},
         std::vector<std::string>{"--set", "simulation.scheme=\"MUSL\"", "--set",
                                  "simulation.cfl=0.9"}}) {
     std::vector<std::string> args = {"check", bar_scene()};
@@ -629,6 +660,30 @@ TEST(Cli, UslAboveItsLimitWarns) {
     ASSERT_EQ(quiet.exit_code, 0) << quiet.describe();
     EXPECT_TRUE(quiet.err.empty()) << quiet.describe();
   }
+}
+
+// A run that blows up without a particle check tripping stops at the energy
+// guard (app/energy_guard.hpp): USL with uGIMP at cfl 0.75 grew the bar's
+// K + U to ~800 times its initial energy in 0.2 ms (2701 steps) at finite J
+// and ended with exit 0 before. Now exit 3, the stage, step and fastest
+// particle named, and no summary.json (an abandoned run's outputs).
+TEST(Cli, EnergyGrowthStopsAnUnstableRun) {
+  TempDir tmp;
+  const CmdResult r = run_mmpm({"run", bar_scene(), "--quiet", "--out", (tmp / "o").string(),
+                                "--set", "simulation.scheme=\"USL\"", "--set",
+                                "simulation.cfl=0.75", "--set", "simulation.end_time=0.2"});
+  ASSERT_EQ(r.exit_code, 3) << r.describe();
+  EXPECT_TRUE(contains(r.err, "unstable: stage energy check, step ")) << r.err;
+  EXPECT_TRUE(contains(r.err, ", particle ")) << r.err;
+  EXPECT_TRUE(contains(r.err, "times what the run was given (initial energy 0.02438")) << r.err;
+  EXPECT_TRUE(contains(r.err, "this is the fastest particle")) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(tmp / "o" / "summary.json"));
+  // The same bar at the shape's limit runs to the end.
+  TempDir ok;
+  const CmdResult stable = run_mmpm({"run", bar_scene(), "--quiet", "--out", (ok / "o").string(),
+                                     "--set", "simulation.scheme=\"USL\"", "--set",
+                                     "simulation.cfl=0.55", "--set", "simulation.end_time=0.2"});
+  EXPECT_EQ(stable.exit_code, 0) << stable.describe();
 }
 
 // An interface with force_limit = false too stiff for the step

@@ -754,6 +754,10 @@ TEST(SceneParseErrors, MissingRequiredKeys) {
   expect_missing("shape = \"box\"\nmin = [1.0, 1.0]", "[[body]]", "body[0].shape");
   expect_missing("max = [4.0, 9.0]\n", "[[body]]", "body[0].max");
   expect_missing("Dt = 5.0\n", "[[interaction]]", "interaction[0].Dt");
+  // A Coulomb law names its coefficient (left at 0 it would be frictionless).
+  const Mutation coulomb = mutate(kBase, "law = \"interface\"", "law = \"friction\"");
+  expect_error(coulomb.text, line_of(coulomb.text, "[[interaction]]"), "interaction[0].friction",
+               {"missing required key", "law = \"friction\" needs its coefficient"});
   expect_missing("fix = [\"x\", \"y\"]\n", "[[boundary]]", "boundary[0].fix");
   // A whole section missing: no line to name.
   const std::string no_grid =
@@ -773,6 +777,16 @@ TEST(SceneParseErrors, MissingShapeGeometryAndTransverseConstants) {
       "type = \"transverse\"\ndensity = 2.0e-3\nEA = 1.0e4\nET = 1.0e3\nnuA = 0.2\nnuT = 0.3");
   expect_error(tr.text, line_of(tr.text, "[[material]]\nname = \"b\""), "material[1].GA",
                {"missing required key", "\"transverse\" material needs it"});
+}
+
+// A rule across two sections is reported at the key it rejects, as written.
+TEST(SceneParseErrors, NeoHookeanInPlaneStress) {
+  const std::string stress =
+      mutate(kBase, "[simulation]\n", "[simulation]\nplane = \"stress\"\n").text;
+  const Mutation m =
+      mutate(stress, "name = \"b\"\ntype = \"isotropic\"", "name = \"b\"\ntype = \"neohookean\"");
+  expect_error(m.text, line_of(m.text, "type = \"neohookean\""), "material[1].type",
+               {"a neohookean material needs plane = \"strain\" or 3D"});
 }
 
 TEST(SceneParseErrors, GridValues) {
@@ -1087,14 +1101,32 @@ TEST(SceneParse, OneSeparationMethodPerScene) {
            "nu = 0.3\n\n[[interaction]]\nmaterials = [\"a\", \"c\"]\nlaw = \"stick\"\n" +
            second;
   };
+  // Two interactions that name different methods: rejected at the second
+  // one's key, naming the first.
+  const std::string mixed =
+      with_third("separation = \"displacement\"\n", "separation = \"position\"\n");
   try {
-    (void)plan_fields(parse_scene_text(with_third("", "separation = \"position\"\n"), "m.toml"));
+    (void)plan_fields(parse_scene_text(mixed, "m.toml"));
     ADD_FAILURE() << "mixed separation methods were accepted";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("every interaction of a scene must use the same "
                                          "separation method"),
               std::string::npos)
         << e.what();
+    const std::string at = "m.toml:" + std::to_string(line_of(mixed, "separation = \"position\"")) +
+                           ": key 'interaction[1].separation'";
+    EXPECT_EQ(std::string(e.what()).rfind(at, 0), 0u) << e.what();
+    EXPECT_NE(std::string(e.what()).find("interaction[0] (line "), std::string::npos) << e.what();
+  }
+  // An interaction that names none takes the method another names, before
+  // or after it.
+  for (const auto& [first, second] :
+       {std::pair<std::string, std::string>{"", "separation = \"position\"\n"},
+        std::pair<std::string, std::string>{"separation = \"position\"\n", ""}}) {
+    const Scene inherited = parse_scene_text(with_third(first, second), "m.toml");
+    for (const InteractionSpec& it : inherited.interactions)
+      EXPECT_EQ(it.separation, Separation::position);
+    EXPECT_TRUE(plan_fields(inherited).position_separation);
   }
   const Scene scene = parse_scene_text(
       with_third("separation = \"extrapolated\"\n", "separation = \"extrapolated\"\n"), "m.toml");

@@ -9,10 +9,12 @@
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <ostream>
 #include <sstream>
 
 #include "app/build_info.hpp"
+#include "app/energy_guard.hpp"
 #include "app/interrupt.hpp"
 #include "app/output_directory.hpp"
 #include "app/start_warnings.hpp"
@@ -78,8 +80,7 @@ std::vector<std::string> series_names(const Simulation& sim) {
 }
 
 void add_series_row(Simulation& sim, DriverState& st,
-                    const std::array<double, kStageCount>& stage_s, int dim) {
-  const Energies e = sim.energies();
+                    const std::array<double, kStageCount>& stage_s, int dim, const Energies& e) {
   // energy_balance: energy now (incl. what damping removed) minus the
   // initial energy and the external work; zero for an exact integrator.
   const double total = e.kinetic + e.strain + e.interface + e.damping;
@@ -312,7 +313,7 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
   };
 
   if (!resume) {
-    add_series_row(*sim, st, sim_stages(), dim);
+    add_series_row(*sim, st, sim_stages(), dim, sim->energies());
     snapshot_if_due(false);
   }
   std::string stopped_by = "end_time";
@@ -320,6 +321,16 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
   const long stop_check =
       scene.stop.enabled ? std::max(1L, std::min<long>(series_every, scene.stop.hold_steps / 4))
                          : 0;
+  // The energy guard looks at every series row, and every 100 steps when
+  // the rows are sparser (a particle pass: ~0.1 % of a step at 100).
+  const long guard_every = std::min(series_every, 100L);
+  const EnergyGuard guard = [&] {
+    double mass = 0;
+    for (const double m : sim->particle_field("mass").values) mass += m;
+    // Step 0's row, which a restarted run carries over.
+    const double initial = st.columns[2][0] + st.columns[3][0] + st.columns[4][0];
+    return make_energy_guard(initial, mass, fastest_wave_speed(scene));
+  }();
   const double ckpt_s = o.checkpoint_minutes * 60.0;
   auto last_ckpt = Clock::now();
   try {
@@ -327,8 +338,16 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
       sim->step_within(end_time);
       const long s = sim->step_count();
       bool stop = false;
+      std::optional<Energies> energies;
+      auto energies_now = [&]() -> const Energies& {
+        if (!energies) energies = sim->energies();
+        return *energies;
+      };
+      if (s % guard_every == 0)
+        if (const std::string why = guard.check(energies_now()); !why.empty())
+          sim->fail_at_fastest_particle("energy check", why);
       if (stop_check > 0 && s % stop_check == 0) {
-        const Energies e = sim->energies();
+        const Energies& e = energies_now();
         const double stored = e.strain + e.interface;
         const double ratio = stored > 0 ? e.kinetic / stored : INFINITY;
         if (ratio < scene.stop.kinetic_ratio && !still_driven(scene, sim->time())) {
@@ -338,7 +357,8 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
           st.streak_start = -1;
         }
       }
-      if (s % series_every == 0 || stop) add_series_row(*sim, st, sim_stages(), dim);
+      if (s % series_every == 0 || stop)
+        add_series_row(*sim, st, sim_stages(), dim, energies_now());
       snapshot_if_due(false);
       if (stop) {
         stopped_by = "kinetic_ratio";
@@ -362,6 +382,9 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
       }
       progress.update(s, sim->time());
     }
+    // The last steps since the guard's last look.
+    if (const std::string why = guard.check(sim->energies()); !why.empty())
+      sim->fail_at_fastest_particle("energy check", why);
   } catch (const SimulationError& e) {
     progress.done();
     writer->abandon();
@@ -372,7 +395,7 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
   progress.update(sim->step_count(), sim->time(), true);
   progress.done();
   if (st.columns.empty() || st.columns[1].back() != double(sim->step_count()))
-    add_series_row(*sim, st, sim_stages(), dim);
+    add_series_row(*sim, st, sim_stages(), dim, sim->energies());
   snapshot_if_due(true);
   writer->write_series(st.names, st.columns);
   writer->finish();

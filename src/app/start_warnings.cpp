@@ -41,6 +41,7 @@ std::vector<std::string> start_warnings(const Scene& scene, const Simulation& si
   if (std::string w = usl_time_step_warning(scene, dt); !w.empty()) out.push_back(std::move(w));
   for (std::string& w : stiff_interface_warnings(scene, dt)) out.push_back(std::move(w));
   for (std::string& w : open_contact_warnings(scene, sim)) out.push_back(std::move(w));
+  for (std::string& w : bonded_position_interface_warnings(scene, sim)) out.push_back(std::move(w));
   for (std::string& w : extrapolated_separation_warnings(scene)) out.push_back(std::move(w));
   return out;
 }

@@ -553,6 +553,14 @@ class SceneReader {
           located(src_.label(), 0, "body", "missing: a scene needs at least one [[body]]"));
     }
     for (const Table& t : sections(top, "interaction")) add_interaction(t);
+    // One separation method per scene: the interactions that do not name
+    // one take the method another names (else the default, displacement).
+    const auto named = std::find(separation_named_.begin(), separation_named_.end(), true);
+    if (named != separation_named_.end()) {
+      const Separation method =
+          scene_.interactions[std::size_t(named - separation_named_.begin())].separation;
+      for (InteractionSpec& it : scene_.interactions) it.separation = method;
+    }
     const auto boundaries = sections(top, "boundary");
     for (std::size_t i = 0; i < boundaries.size(); ++i) add_boundary(boundaries[i], i);
     for (const Table& t : sections(top, "load")) add_load(t);
@@ -778,7 +786,15 @@ class SceneReader {
     m.where = t.where();
     const Field name = t.need("name");
     m.name = name.name();
-    m.type = t.need("type").choice(kMaterialTypeNames);
+    const Field type = t.need("type");
+    m.type = type.choice(kMaterialTypeNames);
+    // Checked here, not only where the model is built (model/material.cpp),
+    // so the message names this key as written (a --set one included).
+    if (m.type == MaterialType::neohookean && dim() == 2 &&
+        scene_.simulation.plane == Plane::stress)
+      type.fail(
+          "a neohookean material needs plane = \"strain\" or 3D ([simulation] plane is "
+          "\"stress\")");
     t.only(material_keys(m.type), a_quoted(scene_name(m.type)) + " material");
     if (const MaterialSpec* other = find_material(m.name)) {
       name.fail("duplicate material name " + quote(m.name) + " (first defined at line " +
@@ -1061,7 +1077,12 @@ class SceneReader {
     const auto pair = interaction_pair(mats);
     in.materials = {pair.first->name, pair.second->name};
     if (auto f = t.get("law")) in.law = f->choice(kLawNames);
-    if (auto f = t.get("friction")) in.friction = f->non_negative();
+    // No default coefficient: a Coulomb law left at 0 would be the
+    // frictionless one under another name.
+    if (auto f = in.law == Law::friction
+                     ? std::optional(t.need("friction", "law = \"friction\" needs its coefficient"))
+                     : t.get("friction"))
+      in.friction = f->non_negative();
     const bool interface = in.law == Law::interface;
     const std::string why = "law = \"interface\" needs Dn and Dt";
     if (auto f = interface ? std::optional(t.need("Dn", why)) : t.get("Dn")) in.Dn = stiffness(*f);
@@ -1069,7 +1090,21 @@ class SceneReader {
     if (auto f = t.get("traction_law")) in.traction_law = f->choice(kTractionLawNames);
     if (auto f = t.get("Dn_compression")) in.Dn_compression = stiffness(*f);
     read_normal(t, in, *pair.first, *pair.second);
-    if (auto f = t.get("separation")) in.separation = f->choice(kSeparationNames);
+    const auto separation = t.get("separation");
+    if (separation) in.separation = separation->choice(kSeparationNames);
+    // One method per scene (mx holds one kind of data, solver/field_plan.cpp),
+    // checked here so the message names this interaction's key as written.
+    for (std::size_t k = 0; separation && k < scene_.interactions.size(); ++k) {
+      const InteractionSpec& other = scene_.interactions[k];
+      if (!separation_named_[k] || other.separation == in.separation) continue;
+      separation->fail(
+          "every interaction of a scene must use the same separation method; interaction[" +
+          std::to_string(k) + "]" +
+          (other.where.line > 0 ? " (line " + std::to_string(other.where.line) + ")" : "") +
+          " names " + quote(scene_name(other.separation)) + ", this one " +
+          quote(scene_name(in.separation)));
+    }
+    separation_named_.push_back(separation.has_value());
     if (auto f = t.get("contact_offset")) {
       if (in.separation != Separation::position)
         f->fail("contact_offset applies to separation = \"position\" only");
@@ -1372,6 +1407,7 @@ class SceneReader {
   std::unordered_map<std::string, std::size_t> body_index_;  // name -> scene_.bodies index
   const toml::value empty_ = toml::table{};
   Scene scene_;
+  std::vector<bool> separation_named_;  // per interaction: its table names `separation`
 };
 
 // ------------------------------------------------------------- --set --

@@ -112,18 +112,19 @@ double nearest_pair(const CellGrid& g, const std::vector<double>& x, const Binne
   return best;
 }
 
-std::vector<OpenContact> open_contacts(const Scene& scene, const FieldPlan& plan,
-                                       const Simulation& sim) {
+// The pairs of fields whose law `wanted` accepts (the default law's pairs
+// included; two rigid fields never meet in the multimaterial pass), each
+// with the closest its particles come.
+template <class Wanted>
+std::vector<OpenContact> measured_pairs(const Scene& scene, const FieldPlan& plan,
+                                        const Simulation& sim, Wanted&& wanted) {
   std::vector<OpenContact> out;
-  if (!plan.multimaterial || plan.position_separation) return out;
-  // Every pair of fields under a contact law, the default law's pairs
-  // included; two rigid fields never meet in the multimaterial pass.
   std::vector<OpenContact> checked;
   const std::size_t F = std::size_t(plan.fields);
   for (std::size_t a = 0; a < F; ++a)
     for (std::size_t b = a + 1; b < F; ++b) {
       const int l = plan.pair[a * F + b];
-      if (l < 0 || !is_contact_law(plan.laws[std::size_t(l)].law)) continue;
+      if (l < 0 || !wanted(plan.laws[std::size_t(l)].law)) continue;
       if (plan.rigid[a] && plan.rigid[b]) continue;
       checked.push_back({l, {int(a), int(b)}, 0, 0});
     }
@@ -156,8 +157,17 @@ std::vector<OpenContact> open_contacts(const Scene& scene, const FieldPlan& plan
     for (int d = 0; d < g.dim; ++d)
       seen = std::min(seen, double(reach[std::size_t(d)]) * g.h[std::size_t(d)]);
     if (c.nearest > seen * (1 + 1e-9)) c.nearest = std::numeric_limits<double>::infinity();
-    if (c.nearest > c.touching) out.push_back(c);
+    out.push_back(c);
   }
+  return out;
+}
+
+std::vector<OpenContact> open_contacts(const Scene& scene, const FieldPlan& plan,
+                                       const Simulation& sim) {
+  std::vector<OpenContact> out;
+  if (!plan.multimaterial || plan.position_separation) return out;
+  for (const OpenContact& c : measured_pairs(scene, plan, sim, is_contact_law))
+    if (c.nearest > c.touching) out.push_back(c);
   return out;
 }
 
@@ -208,6 +218,31 @@ std::vector<std::string> open_contact_warnings(const Scene& scene, const Simulat
   const FieldPlan plan = plan_fields(scene);
   for (const OpenContact& c : open_contacts(scene, plan, sim))
     out.push_back(open_contact_warning(scene, plan, c));
+  return out;
+}
+
+std::vector<std::string> bonded_position_interface_warnings(const Scene& scene,
+                                                            const Simulation& sim) {
+  std::vector<std::string> out;
+  const FieldPlan plan = plan_fields(scene);
+  if (!plan.multimaterial || !plan.position_separation) return out;
+  auto interface = [](Law law) { return law == Law::interface; };
+  for (const OpenContact& c : measured_pairs(scene, plan, sim, interface)) {
+    const std::size_t l = std::size_t(c.law);
+    if (!(c.nearest <= c.touching) || l >= scene.interactions.size()) continue;
+    const InteractionSpec& it = scene.interactions[l];
+    std::ostringstream m;
+    m.precision(4);
+    m << interaction_warning(scene, l, "separation") << "materials '" << it.materials[0]
+      << "' and '" << it.materials[1] << "' start bonded (their nearest particles are " << c.nearest
+      << " apart; touching bodies' are at most " << c.touching
+      << "), and their interface reads its opening from the particles' positions: the "
+         "centroids of two bonded materials lie about 3/4 of a cell apart at a node, so the "
+         "interface starts loaded by D (that offset - contact_offset x h) and by the "
+         "centroids' tangential offsets. separation = \"displacement\" (the default) is "
+         "meant for interfaces that start bonded";
+    out.push_back(m.str());
+  }
   return out;
 }
 

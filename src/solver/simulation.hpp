@@ -76,6 +76,12 @@ class Simulation {
   virtual int field_count() const = 0;
   virtual int tile_edge() const = 0;
   virtual Energies energies() const = 0;  // evaluated now (not cached)
+  // Throws the SimulationError of a run that went unstable without a
+  // particle check tripping (app/energy_guard.hpp), naming `stage`, the step
+  // and the fastest deformable particle (or the first with a non-finite
+  // velocity); `why` says what was found.
+  [[noreturn]] virtual void fail_at_fastest_particle(const char* stage,
+                                                     const std::string& why) const = 0;
   virtual StepCounters counters() const = 0;
   virtual std::vector<Reaction> reactions() const = 0;  // from the last step
   // Particle quantities by name: position, displacement, velocity, stress,
@@ -105,8 +111,12 @@ std::unique_ptr<Simulation> make_simulation(const Scene& scene);
 double stable_time_step(const Scene& scene);
 double critical_time_step(const Scene& scene);  // the same with cfl = 1
 double damping_time_step(const Scene& scene);   // 2 / grid.damping (its own limit)
+double fastest_wave_speed(const Scene& scene);  // the materials' fastest dilatational wave
+// The largest cfl at which USL ran the bars of docs/validation.md §3.5
+// stable, per shape (1.0 for the cubic B-spline: MUSL's and USF's bound).
+double usl_cfl_limit(ShapeKind shape);
 // `run` and `check`: a warning (one line, empty if none) when scheme = "USL"
-// takes a step above its measured limit, cfl = 0.75 (docs/validation.md §3.5).
+// takes a step above usl_cfl_limit.
 std::string usl_time_step_warning(const Scene& scene, double dt);
 // `run` and `check`: one warning per interface with force_limit = false whose
 // stiffest finite D makes omega dt > 2 at a node the interface halves

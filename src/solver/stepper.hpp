@@ -59,6 +59,8 @@ class Stepper final : public Simulation {
   int field_count() const override { return plan_.fields; }
   int tile_edge() const override { return tiles_.T; }
   Energies energies() const override;
+  [[noreturn]] void fail_at_fastest_particle(const char* stage,
+                                             const std::string& why) const override;
   StepCounters counters() const override {
     StepCounters c = mm_.counters();
     c.mm_fields_with_p2g = mm_fields_scattered_with_p2g_;
@@ -248,6 +250,10 @@ class Stepper final : public Simulation {
   // kinetic energy computed before that P2G overwrote m.
   bool grid_ready_ = false;
   double grid_ke_ = 0;
+  // This step ended with a fused tail, so grid_ke_ is its grid kinetic
+  // energy (m is the next P2G's, complete or not: a tail whose particles
+  // changed tiles leaves it partial, and grid_ready_ false).
+  bool grid_ke_from_tail_ = false;
   long p2g_from_tail_ = 0;
 
   // Per-material particle lists (several materials, constitutive pass unfused).

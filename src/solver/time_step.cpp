@@ -8,6 +8,7 @@
 
 #include "model/material.hpp"
 #include "scene/error.hpp"
+#include "scene/format.hpp"
 #include "scene/interaction_warning.hpp"
 #include "solver/simulation.hpp"
 
@@ -67,28 +68,48 @@ double critical_time_step(const Scene& scene) {
   return std::min(wave, damping_time_step(scene));
 }
 
+double fastest_wave_speed(const Scene& scene) {
+  return fastest_wave(scene).speed;
+}
+
 // USL computes the strains from the grid velocity after the momentum
 // update (symplectic Euler on the grid): the fastest grid mode, which
 // couples the directions, bounds its step below the wave-crossing time
 // that `cfl` counts. MUSL and USF read velocities re-extrapolated from the
 // particles, which damp that mode, and run to cfl = 1. Measured for 2 ms on
-// bars of 25 x 1 (x 1) mm, h = 0.5 mm, nu = 0 (docs/validation.md §3.5):
-// USL stable at cfl 0.75 in 2D (uGIMP, linear) and 3D (uGIMP), unstable at
-// 0.78 (2D uGIMP, step 412) and 0.8 (2D linear, 3D uGIMP); MUSL and USF
-// stable at 1.0. A warning, not a refusal: the limit is a measurement, and
-// a scene that ends within a few wave passes may finish before the mode
-// grows.
-constexpr double kUslCflLimit = 0.75;
+// bars of 25 x 1 (x 1) mm, h = 0.5 mm, 2 particles per cell and direction,
+// nu = 0, one end free and one on a support plane, and both free
+// (docs/validation.md §3.5, remeasured 2026-11-28 after a sweep found uGIMP
+// blowing up below the 0.75 measured before): uGIMP stable at 0.55, growing
+// at 0.6 on a support (2D and 3D) and at 0.65 free; quadratic B-splines
+// stable at 0.7, growing at 0.75 free; linear stable at 0.75 on a support
+// (free, it breaks at cell crossings at any step); cubic B-splines stable
+// to 1.0. A warning, not a refusal: the limit is a measurement, and a scene
+// that ends within a few wave passes may finish before the mode grows; the
+// energy guard (app/energy_guard.hpp) stops one that does not.
+double usl_cfl_limit(ShapeKind shape) {
+  switch (shape) {
+    case ShapeKind::linear:
+      return 0.75;
+    case ShapeKind::gimp:
+      return 0.55;
+    case ShapeKind::bspline2:
+      return 0.7;
+    case ShapeKind::bspline3:
+      return 1.0;
+  }
+  return 0.55;
+}
 
 std::string usl_time_step_warning(const Scene& scene, double dt) {
   if (scene.simulation.scheme != Scheme::USL) return {};
-  const double limit = kUslCflLimit;
+  const double limit = usl_cfl_limit(scene.grid.shape);
   const double cfl = dt / critical_time_step(scene);
   if (!(cfl > limit * (1 + 1e-12))) return {};
   const Where& w = scene.simulation.step_where;
   std::ostringstream m;
   m << scene.source_file << ": warning: key '" << (w.key.empty() ? "simulation.cfl" : w.key)
-    << "': scheme \"USL\" is "
+    << "': scheme \"USL\" with shape \"" << scene_name(scene.grid.shape) << "\" is "
     << "stable only to about cfl = " << limit << " (measured); this step is cfl "
     << std::setprecision(3) << cfl
     << ". Use a smaller step, or scheme \"MUSL\" (stable to cfl = 1)";
