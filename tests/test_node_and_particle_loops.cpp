@@ -298,7 +298,7 @@ double reference_update(Grid2& g, const GridUpdateParams& q) {
         g.p[d][i] = p + q.dt * force;
         pv += p * p * inv_m;
       }
-      loss += q.damping * q.dt * (1.0 - 0.5 * q.damping * q.dt) * pv;  // grid_update.hpp
+      loss += q.damping * q.dt * pv;
     }
   }
   return loss;

@@ -20,9 +20,11 @@ std::string EnergyGuard::check(const Energies& e) const {
   std::ostringstream m;
   m.precision(4);
   m << "the energy K + U + U_int reached " << now;
-  if (given > 0) m << ", " << now / given << " times";
-  m << " what the run was given (initial energy " << initial << ", external work "
-    << e.external_work << ")";
+  if (given > 0)
+    m << ", " << now / given << " times what the run was given";
+  else
+    m << " while the run was given none";
+  m << " (initial energy " << initial << ", external work " << e.external_work << ")";
   return m.str();
 }
 
