@@ -322,7 +322,8 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
       scene.stop.enabled ? std::max(1L, std::min<long>(series_every, scene.stop.hold_steps / 4))
                          : 0;
   // The energy guard looks at every series row, and every 100 steps when
-  // the rows are sparser (a particle pass: ~0.1 % of a step at 100).
+  // the rows are sparser (the default rows are 100 steps apart, so by
+  // default it costs nothing: the rows compute the energies anyway).
   const long guard_every = std::min(series_every, 100L);
   const EnergyGuard guard = [&] {
     double mass = 0;

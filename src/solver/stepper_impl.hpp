@@ -216,8 +216,7 @@ void Stepper<D, Shape, Real>::setup_particles(const ParticleSeeds& seeds) {
 }
 
 // The fused update's per-material table (gradient_and_stress sets each
-// step's dt);
-// fusing needs every stressed material to be isotropic
+// step's dt); fusing needs every stressed material to be isotropic
 // (kernels/constitutive.hpp IsotropicStressUpdate).
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::build_stress_table() {
@@ -904,8 +903,9 @@ MirrorView<Real> Stepper<D, Shape, Real>::mirror_view(MirrorPlane& mp) const {
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::fold_mirrors(unsigned what, bool with_reaction) {
   const bool reaction = with_reaction && (what & kFoldForce);
-  for (MirrorPlane& mp : mirrors_)
-    if (reaction) mp.fold_terms.resize(mp.ghost.size() * std::size_t(G_.fields * D));
+  if (reaction)
+    for (MirrorPlane& mp : mirrors_)
+      mp.fold_terms.resize(mp.ghost.size() * std::size_t(G_.fields * D));
 #pragma omp parallel if (G_.nodes * std::size_t(G_.fields) >= kParallelMin)
   {
     const auto [first, last] = own_.mine(G_.nodes);
