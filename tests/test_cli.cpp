@@ -484,6 +484,20 @@ TEST(Cli, UnwritableOutputDirectoryIsBadInput) {
   }
 }
 
+// The one warning `check` printed, about interaction[0].separation of
+// `scene`, with the interaction's file:line in front; empty (after a
+// failure) if there is not exactly one.
+std::string one_separation_warning(const CmdResult& r, const std::string& scene) {
+  EXPECT_EQ(r.exit_code, 0) << r.describe();
+  const auto lines = lines_of(r.err);
+  EXPECT_EQ(lines.size(), 1u) << r.describe();
+  if (lines.size() != 1) return {};
+  const std::string where =
+      scene + ":" + std::to_string(line_of(read_text(scene), "[[interaction]]")) + ":";
+  EXPECT_TRUE(contains(lines[0], where + " warning: key 'interaction[0].separation'")) << lines[0];
+  return lines[0];
+}
+
 // Contact with separation = "displacement" assumes bodies that touch at the
 // start (ALGORITHM §3); `check` and `run` warn when a contact pair starts
 // apart (solver/contact_gap.hpp). collision.toml's blocks (h = 0.5 mm,
@@ -495,16 +509,11 @@ TEST(Cli, UnwritableOutputDirectoryIsBadInput) {
 TEST(Cli, ContactPairsThatStartApartWarnWithDisplacementSeparation) {
   const std::string collision = source_dir() + "/inputs/collision.toml";
   const std::string disp = "interaction[0].separation=\"displacement\"";
-  const CmdResult apart =
-      run_mmpm({"check", collision, "--set", disp, "--set", "body[1].min=[12.25, 2.0]"});
-  ASSERT_EQ(apart.exit_code, 0) << apart.describe();
-  const auto lines = lines_of(apart.err);
-  ASSERT_EQ(lines.size(), 1u) << apart.describe();
-  const std::string where =
-      collision + ":" + std::to_string(line_of(read_text(collision), "[[interaction]]")) + ":";
-  EXPECT_TRUE(contains(lines[0], where + " warning: key 'interaction[0].separation'")) << lines[0];
-  EXPECT_TRUE(contains(lines[0], "nearest particles are 0.5 apart")) << lines[0];
-  EXPECT_TRUE(contains(lines[0], "at most 0.375")) << lines[0];
+  const std::string apart = one_separation_warning(
+      run_mmpm({"check", collision, "--set", disp, "--set", "body[1].min=[12.25, 2.0]"}),
+      collision);
+  EXPECT_TRUE(contains(apart, "nearest particles are 0.5 apart")) << apart;
+  EXPECT_TRUE(contains(apart, "at most 0.375")) << apart;
 
   const CmdResult touching =
       run_mmpm({"check", collision, "--set", disp, "--set", "body[1].min=[12.0, 2.0]"});
@@ -524,15 +533,10 @@ TEST(Cli, ContactPairsThatStartApartWarnWithDisplacementSeparation) {
 TEST(Cli, ExtrapolatedSeparationWithOneParticlePerCellWarns) {
   const std::string scene = source_dir() + "/inputs/two_layer.toml";
   const std::string extrapolated = "interaction[0].separation=\"extrapolated\"";
-  const CmdResult one =
-      run_mmpm({"check", scene, "--set", extrapolated, "--set", "body[1].particles_per_cell=1"});
-  ASSERT_EQ(one.exit_code, 0) << one.describe();
-  const auto lines = lines_of(one.err);
-  ASSERT_EQ(lines.size(), 1u) << one.describe();
-  const std::string where =
-      scene + ":" + std::to_string(line_of(read_text(scene), "[[interaction]]")) + ":";
-  EXPECT_TRUE(contains(lines[0], where + " warning: key 'interaction[0].separation'")) << lines[0];
-  EXPECT_TRUE(contains(lines[0], "has 1")) << lines[0];
+  const std::string one = one_separation_warning(
+      run_mmpm({"check", scene, "--set", extrapolated, "--set", "body[1].particles_per_cell=1"}),
+      scene);
+  EXPECT_TRUE(contains(one, "has 1")) << one;
   const CmdResult two = run_mmpm({"check", scene, "--set", extrapolated});
   EXPECT_EQ(two.exit_code, 0) << two.describe();
   EXPECT_EQ(two.err, "") << two.describe();
@@ -545,16 +549,11 @@ TEST(Cli, ExtrapolatedSeparationWithOneParticlePerCellWarns) {
 // nor position on bodies that start apart (collision.toml's own scene).
 TEST(Cli, PositionSeparationOnABondedInterfaceWarns) {
   const std::string scene = source_dir() + "/inputs/two_layer.toml";
-  const CmdResult bonded =
+  const std::string bonded = one_separation_warning(
       run_mmpm({"check", scene, "--set", "interaction[0].separation=\"position\"", "--set",
-                "interaction[0].Dn=1000.0"});
-  ASSERT_EQ(bonded.exit_code, 0) << bonded.describe();
-  const auto lines = lines_of(bonded.err);
-  ASSERT_EQ(lines.size(), 1u) << bonded.describe();
-  const std::string where =
-      scene + ":" + std::to_string(line_of(read_text(scene), "[[interaction]]")) + ":";
-  EXPECT_TRUE(contains(lines[0], where + " warning: key 'interaction[0].separation'")) << lines[0];
-  EXPECT_TRUE(contains(lines[0], "start bonded")) << lines[0];
+                "interaction[0].Dn=1000.0"}),
+      scene);
+  EXPECT_TRUE(contains(bonded, "start bonded")) << bonded;
   const CmdResult apart =
       run_mmpm({"check", source_dir() + "/inputs/collision.toml", "--set",
                 "interaction[0].law=\"interface\"", "--set", "interaction[0].Dn=1000.0", "--set",

@@ -334,6 +334,7 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
   }();
   const double ckpt_s = o.checkpoint_minutes * 60.0;
   auto last_ckpt = Clock::now();
+  std::optional<Energies> final_energies;
   try {
     while (sim->time() < end_time - 1e-9 * sim->dt()) {
       sim->step_within(end_time);
@@ -383,8 +384,9 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
       }
       progress.update(s, sim->time());
     }
-    // The last steps since the guard's last look.
-    if (const std::string why = guard.check(sim->energies()); !why.empty())
+    // The last steps since the guard's last look; the final row reuses them.
+    final_energies = sim->energies();
+    if (const std::string why = guard.check(*final_energies); !why.empty())
       sim->fail_at_fastest_particle("energy check", why);
   } catch (const SimulationError& e) {
     progress.done();
@@ -396,7 +398,7 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
   progress.update(sim->step_count(), sim->time(), true);
   progress.done();
   if (st.columns.empty() || st.columns[1].back() != double(sim->step_count()))
-    add_series_row(*sim, st, sim_stages(), dim, sim->energies());
+    add_series_row(*sim, st, sim_stages(), dim, *final_energies);
   snapshot_if_due(true);
   writer->write_series(st.names, st.columns);
   writer->finish();
