@@ -1085,6 +1085,19 @@ TEST(SceneParseOverrides, BadOverridesNameSet) {
   EXPECT_NE(msg.find("KEY=VALUE"), std::string::npos) << msg;
 }
 
+// A section the file lacks, made by a --set: its missing keys are the
+// file's omission. The message names the file first, the key, and the --set
+// that made the section (an empty file once read "--set simulation.cfl: key
+// 'simulation.dimension': missing required key", blaming the override).
+TEST(SceneParseOverrides, SectionMadeBySetBlamesTheFileForMissingKeys) {
+  const std::string msg = error_of("", {"simulation.cfl=0.3"});
+  EXPECT_EQ(msg.rfind(kLabel + ": ", 0), 0u) << msg;
+  EXPECT_NE(msg.find("key 'simulation.dimension'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("missing required key"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("only '--set simulation.cfl' made it"), std::string::npos) << msg;
+  EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+}
+
 // One separation method per scene (mx holds one kind of data,
 // solver/field_plan.cpp): kBase with a third material and a second
 // interaction; "position" there and the first's default "displacement" are

@@ -316,10 +316,19 @@ class Table {
     return Field(it->second, join(path_, key), *src_);
   }
 
-  // A missing key is reported at the table's own line (its [header]).
+  // A missing key is reported at the table's own line (its [header]). A
+  // table only a --set created (the section is absent from the file) is
+  // the file's omission, not the override's: name the file, and the --set.
   Field need(std::string_view key, const std::string& why = "") const {
     if (auto f = get(key)) return *f;
-    fail_key(key, "missing required key" + (why.empty() ? "" : " (" + why + ")"));
+    const std::string what = "missing required key" + (why.empty() ? "" : " (" + why + ")");
+    const Place p = src_->place(*v_);
+    if (p.file.starts_with(kSetPrefix)) {
+      throw InputError(
+          located(src_->label(), 0, join(path_, key),
+                  what + "; the file has no [" + path_ + "], only '" + p.file + "' made it"));
+    }
+    fail_key(key, what);
   }
 
   [[noreturn]] void fail_key(std::string_view key, const std::string& what) const {
