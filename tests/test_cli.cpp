@@ -484,17 +484,18 @@ TEST(Cli, UnwritableOutputDirectoryIsBadInput) {
   }
 }
 
-// The one warning `check` printed, about interaction[0].separation of
-// `scene`, with the interaction's file:line in front; empty (after a
-// failure) if there is not exactly one.
-std::string one_separation_warning(const CmdResult& r, const std::string& scene) {
+// The one warning `check` printed, about interaction[0].KEY of `scene`,
+// with the interaction's file:line in front; empty (after a failure) if
+// there is not exactly one.
+std::string one_interaction_warning(const CmdResult& r, const std::string& scene,
+                                    const std::string& key = "separation") {
   EXPECT_EQ(r.exit_code, 0) << r.describe();
   const auto lines = lines_of(r.err);
   EXPECT_EQ(lines.size(), 1u) << r.describe();
   if (lines.size() != 1) return {};
   const std::string where =
       scene + ":" + std::to_string(line_of(read_text(scene), "[[interaction]]")) + ":";
-  EXPECT_TRUE(contains(lines[0], where + " warning: key 'interaction[0].separation'")) << lines[0];
+  EXPECT_TRUE(contains(lines[0], where + " warning: key 'interaction[0]." + key + "'")) << lines[0];
   return lines[0];
 }
 
@@ -509,7 +510,7 @@ std::string one_separation_warning(const CmdResult& r, const std::string& scene)
 TEST(Cli, ContactPairsThatStartApartWarnWithDisplacementSeparation) {
   const std::string collision = source_dir() + "/inputs/collision.toml";
   const std::string disp = "interaction[0].separation=\"displacement\"";
-  const std::string apart = one_separation_warning(
+  const std::string apart = one_interaction_warning(
       run_mmpm({"check", collision, "--set", disp, "--set", "body[1].min=[12.25, 2.0]"}),
       collision);
   EXPECT_TRUE(contains(apart, "nearest particles are 0.5 apart")) << apart;
@@ -533,7 +534,7 @@ TEST(Cli, ContactPairsThatStartApartWarnWithDisplacementSeparation) {
 TEST(Cli, ExtrapolatedSeparationWithOneParticlePerCellWarns) {
   const std::string scene = source_dir() + "/inputs/two_layer.toml";
   const std::string extrapolated = "interaction[0].separation=\"extrapolated\"";
-  const std::string one = one_separation_warning(
+  const std::string one = one_interaction_warning(
       run_mmpm({"check", scene, "--set", extrapolated, "--set", "body[1].particles_per_cell=1"}),
       scene);
   EXPECT_TRUE(contains(one, "has 1")) << one;
@@ -549,7 +550,7 @@ TEST(Cli, ExtrapolatedSeparationWithOneParticlePerCellWarns) {
 // nor position on bodies that start apart (collision.toml's own scene).
 TEST(Cli, PositionSeparationOnABondedInterfaceWarns) {
   const std::string scene = source_dir() + "/inputs/two_layer.toml";
-  const std::string bonded = one_separation_warning(
+  const std::string bonded = one_interaction_warning(
       run_mmpm({"check", scene, "--set", "interaction[0].separation=\"position\"", "--set",
                 "interaction[0].Dn=1000.0"}),
       scene);
@@ -560,6 +561,33 @@ TEST(Cli, PositionSeparationOnABondedInterfaceWarns) {
                 "interaction[0].Dt=1000.0"});
   EXPECT_EQ(apart.exit_code, 0) << apart.describe();
   EXPECT_EQ(apart.err, "") << apart.describe();
+}
+
+// An interface with a perfect direction and a computed normal (mvg, the
+// default, or avg) and no edge screening: where the interface meets a free
+// edge the normal tilts and the perfect direction locks it (paper 2.5;
+// series_bars with mvg: 1.2 % of the exact interface energy), so `check`
+// warns, naming the interaction's line. The shipped scene (specified
+// normal), screening (min_volume > 0) and finite stiffnesses do not.
+TEST(Cli, ComputedNormalOnAPerfectInterfaceWarns) {
+  const std::string scene = source_dir() + "/inputs/series_bars.toml";
+  const std::string mvg = one_interaction_warning(
+      run_mmpm({"check", scene, "--set", "interaction[0].normal=\"mvg\""}), scene, "normal");
+  EXPECT_TRUE(contains(mvg, "normal = \"mvg\" (the default) with Dt = \"perfect\"")) << mvg;
+  EXPECT_TRUE(contains(mvg, "min_volume")) << mvg;
+  const std::string avg = one_interaction_warning(
+      run_mmpm({"check", scene, "--set", "interaction[0].normal=\"avg\""}), scene, "normal");
+  EXPECT_TRUE(contains(avg, "normal = \"avg\" with Dt")) << avg;
+  for (const std::vector<std::string>& quiet :
+       {std::vector<std::string>{},
+        {"--set", "interaction[0].normal=\"mvg\"", "--set", "interaction[0].min_volume=0.75"},
+        {"--set", "interaction[0].normal=\"mvg\"", "--set", "interaction[0].Dt=10.0"}}) {
+    std::vector<std::string> args{"check", scene};
+    args.insert(args.end(), quiet.begin(), quiet.end());
+    const CmdResult r = run_mmpm(args);
+    EXPECT_EQ(r.exit_code, 0) << r.describe();
+    EXPECT_EQ(r.err, "") << r.describe();
+  }
 }
 
 // Pairs without an [[interaction]] of their own fall back on [simulation]
