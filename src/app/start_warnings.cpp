@@ -41,7 +41,7 @@ std::vector<std::string> extrapolated_separation_warnings(const Scene& scene) {
 // inputs/series_bars.toml (Dn = 10, Dt perfect, a 4-cell-wide bar):
 // mvg 1.2 % of the exact interface energy, avg exact on that grid-line
 // interface, mvg with min_volume = 0.75 +33 % (the screened edge nodes
-// take their area with them) (docs/interface_validation.md, Finding 8).
+// take their area with them) (docs/interface_validation.md, Finding 9).
 std::vector<std::string> computed_normal_warnings(const Scene& scene) {
   std::vector<std::string> out;
   for (std::size_t k = 0; k < scene.interactions.size(); ++k) {

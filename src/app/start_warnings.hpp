@@ -2,9 +2,9 @@
 // each, in one order: USL above its measured step limit, interfaces too
 // stiff for the step without the force limit, contact pairs that start
 // apart under the displacement separation, the position separation on
-// bodies that start bonded, the extrapolated separation
-// with 1 particle per cell, computed normals on an interface with a perfect
-// direction and no edge screening.
+// bodies that start bonded, the extrapolated separation with 1 particle
+// per cell, computed normals on an interface with a perfect direction and
+// no edge screening.
 #pragma once
 
 #include <string>
