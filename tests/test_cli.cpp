@@ -866,6 +866,28 @@ TEST(Cli, InterruptedSweepMarksItsRows) {
   }
 }
 
+// A sweep prints each distinct scene warning once, with the row that first
+// gave it: warnings that depend on the swept value are not hidden behind
+// row 0's (which is all a sweep printed before 2026-11-29). Over the normal
+// of series_bars, two rows at a time: mvg and avg each warn (two different
+// lines, rows 1 and 2, in row order), the specified normal does not, and
+// row 4's mvg warning is row 1's, not repeated.
+TEST(Cli, SweepPrintsEachRowsOwnWarningsOnce) {
+  TempDir tmp;
+  const std::string scene = source_dir() + "/inputs/series_bars.toml";
+  const CmdResult r =
+      run_mmpm({"sweep", scene, "--param", "interaction[0].normal", "--values",
+                "\"mvg\",\"avg\",\"specified\",\"mvg\"", "--set", "simulation.end_time=0.002",
+                "--jobs", "2", "--quiet", "--out", (tmp / "sweep").string()});
+  ASSERT_EQ(r.exit_code, 0) << r.describe();
+  const auto lines = lines_of(r.err);
+  ASSERT_EQ(lines.size(), 2u) << r.describe();
+  EXPECT_EQ(lines[0].rfind("[1/4] interaction[0].normal=\"mvg\": " + scene, 0), 0u) << lines[0];
+  EXPECT_TRUE(contains(lines[0], "normal = \"mvg\"")) << lines[0];
+  EXPECT_EQ(lines[1].rfind("[2/4] interaction[0].normal=\"avg\": " + scene, 0), 0u) << lines[1];
+  EXPECT_TRUE(contains(lines[1], "normal = \"avg\"")) << lines[1];
+}
+
 TEST(Cli, SweepWritesTableAndOneSummaryPerValue) {
   TempDir tmp;
   const fs::path out = tmp / "sweep";

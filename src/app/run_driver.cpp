@@ -230,7 +230,11 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
   check_step_count(scene, dt);
   std::unique_ptr<Simulation> sim = make_simulation(scene);
   if (!resume && opt.warnings) {
-    for (const std::string& w : start_warnings(scene, *sim, dt)) std::cerr << w << "\n";
+    const std::vector<std::string> warnings = start_warnings(scene, *sim, dt);
+    if (opt.on_warnings)
+      opt.on_warnings(warnings);
+    else
+      for (const std::string& w : warnings) std::cerr << w << "\n";
   }
   const int dim = scene.simulation.dimension;
   DriverState st;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <iosfwd>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -20,6 +21,9 @@ struct RunOptions {
   bool progress = true;  // progress line when stderr is a terminal
   bool timing_table = true;
   bool warnings = true;  // scene warnings (start_warnings) on stderr before a fresh start
+  // When set, the scene warnings go here instead of stderr (a sweep prints
+  // each distinct one once, naming the row that first gave it).
+  std::function<void(const std::vector<std::string>&)> on_warnings;
 };
 
 struct RunOutcome {

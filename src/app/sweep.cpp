@@ -4,7 +4,11 @@
 #include <tbb/task_arena.h>
 
 #include <fstream>
+#include <functional>
 #include <iostream>
+#include <mutex>
+#include <optional>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -47,6 +51,36 @@ static std::string csv_quoted(const std::string& s) {
   return out + "\"";
 }
 
+namespace {
+
+// The rows' scene warnings, printed in row order whatever order the rows
+// run in (--jobs), each distinct line once, behind the label of the first
+// row that gave it. A row's first delivery counts (its warnings, or none if
+// it ended before them); later rows wait in `rows` until the earlier ones
+// have delivered.
+class SweepWarnings {
+ public:
+  SweepWarnings(std::size_t n, std::function<std::string(std::size_t)> label)
+      : rows_(n), label_(std::move(label)) {}
+
+  void deliver(std::size_t k, const std::vector<std::string>& warnings) {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (!rows_[k]) rows_[k] = warnings;
+    for (; next_ < rows_.size() && rows_[next_]; ++next_)
+      for (const std::string& w : *rows_[next_])
+        if (printed_.insert(w).second) std::cerr << label_(next_) << w << "\n";
+  }
+
+ private:
+  std::mutex mutex_;
+  std::vector<std::optional<std::vector<std::string>>> rows_;
+  std::size_t next_ = 0;
+  std::set<std::string> printed_;
+  std::function<std::string(std::size_t)> label_;
+};
+
+}  // namespace
+
 int run_sweep(const SweepOptions& opt) {
   namespace fs = std::filesystem;
   const std::size_t n = opt.values.size();
@@ -64,6 +98,13 @@ int run_sweep(const SweepOptions& opt) {
   const int cores = int(std::max(1u, std::thread::hardware_concurrency()));
   const int threads = opt.threads > 0 ? opt.threads : std::max(1, cores / jobs);
   std::vector<RunOutcome> results(n);
+  // Each distinct scene warning once, from the first row that gives it:
+  // warnings that depend on the swept value (the cfl, the normal, the
+  // particles per cell) name their row; row 0 alone would hide them.
+  SweepWarnings warnings(n, [&](std::size_t k) {
+    return "[" + std::to_string(k + 1) + "/" + std::to_string(n) + "] " + opt.param + "=" +
+           opt.values[k] + ": ";
+  });
   tbb::task_arena arena(jobs);
   arena.execute([&] {
     tbb::parallel_for(std::size_t(0), n, [&](std::size_t k) {
@@ -72,7 +113,7 @@ int run_sweep(const SweepOptions& opt) {
       ro.threads = threads;
       ro.quiet = true;
       ro.progress = false;
-      ro.warnings = k == 0;  // the scene's warnings once, not once per value
+      ro.on_warnings = [&, k](const std::vector<std::string>& w) { warnings.deliver(k, w); };
       std::ostringstream log;
       try {
         if (const int sig = pending_interrupt()) {  // the rows not started yet
@@ -88,6 +129,7 @@ int run_sweep(const SweepOptions& opt) {
         results[k].exit_code = 3;
         results[k].message = e.what();
       }
+      warnings.deliver(k, {});  // a row that ended before its warnings has none
       if (!opt.quiet)
         std::cerr << "[" << k + 1 << "/" << n << "] " << opt.param << "=" << opt.values[k] << ": "
                   << (results[k].exit_code == 0 ? "done" : results[k].message) << "\n";
