@@ -573,7 +573,7 @@ TEST(Cli, ComputedNormalOnAPerfectInterfaceWarns) {
   const std::string scene = source_dir() + "/inputs/series_bars.toml";
   const std::string mvg = one_interaction_warning(
       run_mmpm({"check", scene, "--set", "interaction[0].normal=\"mvg\""}), scene, "normal");
-  EXPECT_TRUE(contains(mvg, "normal = \"mvg\" (the default) with Dt = \"perfect\"")) << mvg;
+  EXPECT_TRUE(contains(mvg, "normal = \"mvg\" (mvg is the default) with Dt = \"perfect\"")) << mvg;
   EXPECT_TRUE(contains(mvg, "min_volume")) << mvg;
   const std::string avg = one_interaction_warning(
       run_mmpm({"check", scene, "--set", "interaction[0].normal=\"avg\""}), scene, "normal");

@@ -52,7 +52,7 @@ std::vector<std::string> computed_normal_warnings(const Scene& scene) {
     std::ostringstream m;
     m << interaction_warning(scene, k, "normal") << "normal = \""
       << (it.normal == NormalMethod::mvg ? "mvg" : "avg") << "\""
-      << (it.normal == NormalMethod::mvg ? " (the default)" : "") << " with D"
+      << (it.normal == NormalMethod::mvg ? " (mvg is the default)" : "") << " with D"
       << (std::isinf(it.Dn) ? 'n' : 't')
       << " = \"perfect\" and min_volume = 0: where the interface meets a free edge the "
          "computed normal tilts by up to 45 degrees and the perfect direction locks it "
