@@ -56,7 +56,7 @@ namespace {
 // The rows' scene warnings, printed in row order whatever order the rows
 // run in (--jobs), each distinct line once, behind the label of the first
 // row that gave it. A row's first delivery counts (its warnings, or none if
-// it ended before them); later rows wait in `rows` until the earlier ones
+// it ended before them); later rows wait in `rows_` until the earlier ones
 // have delivered.
 class SweepWarnings {
  public:
