@@ -59,32 +59,38 @@ TEST(LongRuns, UnresolvedKineticEnergyDoesNotCreep) {
   EXPECT_GT(growth, 1.3) << "pure FLIP should show the creep";
 }
 
+// A quiet run of `scene` into `out` (no progress line, no timing table).
+RunOutcome quiet_run(const Scene& scene, const fs::path& out) {
+  RunOptions opt;
+  opt.quiet = true;
+  opt.progress = false;
+  opt.out = out;
+  std::ostringstream log;
+  return run_scene(scene, opt, log);
+}
+
+// The stored energy of a finished run: strain + interface.
+double stored_energy(const RunOutcome& r) {
+  return r.summary["energy"]["strain"].get<double>() +
+         r.summary["energy"]["interface"].get<double>();
+}
+
 // [stop] kinetic_ratio = 1e-4 held 400 steps ends the run early with stopped_by = "kinetic_ratio",
 // and the stored energy then matches the full-length run within 0.5 %.
 TEST(LongRuns, StopCriterionEndsStaticRunEarly) {
   const fs::path dir = fs::temp_directory_path() / "mmpm_stop_test";
   fs::remove_all(dir);
-  RunOptions opt;
-  opt.quiet = true;
-  opt.progress = false;
-  std::ostringstream log;
-  opt.out = dir / "full";
-  const RunOutcome full = run_scene(coarse_two_layer({"simulation.end_time=0.6"}), opt, log);
+  const RunOutcome full = quiet_run(coarse_two_layer({"simulation.end_time=0.6"}), dir / "full");
   ASSERT_EQ(full.exit_code, 0) << full.message;
-  opt.out = dir / "stopped";
   const RunOutcome early =
-      run_scene(coarse_two_layer({"simulation.end_time=0.6", "stop.enabled=true",
+      quiet_run(coarse_two_layer({"simulation.end_time=0.6", "stop.enabled=true",
                                   "stop.kinetic_ratio=1.0e-4", "stop.hold_steps=400"}),
-                opt, log);
+                dir / "stopped");
   ASSERT_EQ(early.exit_code, 0) << early.message;
   EXPECT_EQ(full.summary["stopped_by"], "end_time");
   EXPECT_EQ(early.summary["stopped_by"], "kinetic_ratio");
   EXPECT_LT(early.summary["steps"].get<long>(), full.summary["steps"].get<long>());
-  const auto stored = [](const RunOutcome& r) {
-    return r.summary["energy"]["strain"].get<double>() +
-           r.summary["energy"]["interface"].get<double>();
-  };
-  EXPECT_NEAR(stored(early) / stored(full), 1.0, 0.005);
+  EXPECT_NEAR(stored_energy(early) / stored_energy(full), 1.0, 0.005);
   fs::remove_all(dir);
 }
 
@@ -99,16 +105,11 @@ TEST(LongRuns, StopCriterionEndsStaticRunEarly) {
 TEST(LongRuns, PureFlipStaticRunStops) {
   const fs::path dir = fs::temp_directory_path() / "mmpm_stop_flip_test";
   fs::remove_all(dir);
-  RunOptions opt;
-  opt.quiet = true;
-  opt.progress = false;
-  std::ostringstream log;
   const std::string scene = std::string(MMPM_SOURCE_DIR) + "/inputs/series_bars.toml";
   const auto run = [&](const std::string& flip) {
-    opt.out = dir / flip;
-    return run_scene(parse_scene_file(scene, {"simulation.flip=" + flip, "stop.enabled=true",
+    return quiet_run(parse_scene_file(scene, {"simulation.flip=" + flip, "stop.enabled=true",
                                               "simulation.end_time=3.0"}),
-                     opt, log);
+                     dir / flip);
   };
   const RunOutcome blend = run("0.99");
   const RunOutcome flip = run("1.0");
@@ -117,11 +118,7 @@ TEST(LongRuns, PureFlipStaticRunStops) {
   EXPECT_EQ(blend.summary["stopped_by"], "kinetic_ratio");
   EXPECT_EQ(flip.summary["stopped_by"], "kinetic_ratio");
   EXPECT_LT(flip.summary["end_time"].get<double>(), 2.0);
-  const auto stored = [](const RunOutcome& r) {
-    return r.summary["energy"]["strain"].get<double>() +
-           r.summary["energy"]["interface"].get<double>();
-  };
-  EXPECT_NEAR(stored(flip) / stored(blend), 1.0, 1e-3);
+  EXPECT_NEAR(stored_energy(flip) / stored_energy(blend), 1.0, 1e-3);
   // What the particles keep under pure FLIP: far above the blend's.
   EXPECT_GT(flip.summary["energy"]["kinetic"].get<double>(),
             1e3 * blend.summary["energy"]["kinetic"].get<double>());
