@@ -355,9 +355,9 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
       if (stop_check > 0 && s % stop_check == 0) {
         // The kinetic energy of the grid's velocity field, not the
         // particles': pure FLIP (flip = 1, the default) keeps particle
-        // velocities the grid cannot see, which no damping reaches, and a
-        // damped bar at rest (U 1e-9 mJ) kept 1.2e-4 mJ of them, so the
-        // particles' ratio never fell (docs/validation.md 3.9).
+        // velocities the grid cannot see, which no damping reaches, so the
+        // particles' ratio of a static series_bars rose to 2.6e-5 and the
+        // run never stopped (docs/validation.md 3.9).
         const Energies& e = energies_now();
         const double stored = e.strain + e.interface;
         const double moving = e.kinetic - e.kinetic_unresolved;
