@@ -184,6 +184,37 @@ TEST(ValidationInterface, SeriesBarsNormalCompliance) {
   }
 }
 
+// The bilinear law (ALGORITHM §3.2: stiff in compression, soft in tension)
+// on the same bars: Dn = 10 when the interface opens, Dn_compression = 100
+// when it closes. Pulled (sigma = +0.01 MPa) the bars must read the
+// compliance and interface energy of Dn = 10; pushed (sigma = -0.01 MPa)
+// those of Dn = 100, with a negative opening. A law that took the sign of
+// delta_n from the wrong material, or kept one stiffness, fails one side by
+// the factor 10 in 1/Dn (the interface term is 48 % of the compliance at
+// Dn = 10 and 8.5 % at Dn = 100). Tolerances as SeriesBarsNormalCompliance:
+// compliance 1.5 %, interface energy 0.5 % (h = 0.5 mm, static at 1 ms).
+TEST(ValidationInterface, SeriesBarsBilinearLawTakesTheStiffnessOfTheOpeningsSign) {
+  const double E = 2400, A = 2.0, h = 0.5, Dn_open = 10.0, Dn_closed = 100.0;
+  const std::vector<std::string> bilinear = {"interaction[0].traction_law=\"bilinear\"",
+                                             "interaction[0].Dn_compression=" + num(Dn_closed)};
+  for (double sigma : {0.01, -0.01}) {
+    const BarsResult r = run_bars(Dn_open, sigma, h, 1.0, "\"perfect\"", bilinear);
+    const double Dn = sigma > 0 ? Dn_open : Dn_closed;
+    const auto ex = analytic::series_bars(E, 5.0, E, 5.0, Dn, A, sigma * A);
+    SCOPED_TRACE("sigma = " + num(sigma));
+    std::printf("[bars bilinear] sigma %+g compliance %+.3f %% (vs Dn %g)  U_int/exact %.4f\n",
+                sigma, 100 * (r.compliance / ex.compliance - 1), Dn,
+                r.e.interface / ex.U_interface);
+    EXPECT_TRUE(finite(r.e));
+    EXPECT_LT(r.e.kinetic, 1e-5 * (r.e.strain + r.e.interface)) << "not static";
+    EXPECT_NEAR(r.compliance / ex.compliance, 1.0, 0.015)
+        << "C = " << r.compliance << " exact " << ex.compliance;
+    EXPECT_NEAR(r.e.interface / ex.U_interface, 1.0, 0.005)
+        << "U_int " << r.e.interface << " exact " << ex.U_interface;
+    EXPECT_EQ(r.jump > 0, sigma > 0) << "opening " << r.jump;
+  }
+}
+
 // Dt does not enter (same Poisson contraction on both sides): Dt = Dn gives the same
 // compliance as Dt = perfect within 0.1 %. h = 0.5 mm, Dn = 10 MPa/mm.
 TEST(ValidationInterface, SeriesBarsTangentialStiffnessDoesNotMatter) {
