@@ -364,8 +364,7 @@ const std::array<double, 2> kSlope3D = {2.0 / std::sqrt(5.0), 1.0 / std::sqrt(5.
 
 // Angle in degrees from d to the in-plane part of a.
 double degrees_off_slope(const std::array<double, 3>& a) {
-  return (std::atan2(a[1], a[0]) - std::atan2(kSlope3D[1], kSlope3D[0])) * 180.0 /
-         std::numbers::pi;
+  return (std::atan2(a[1], a[0]) - std::atan2(kSlope3D[1], kSlope3D[0])) * 180.0 / std::numbers::pi;
 }
 
 struct Incline3D {
@@ -381,14 +380,15 @@ struct Motion3D {
 
 // Centre of mass, its velocity and the spin of material 0's particles.
 Motion3D motion_3d(const Simulation& sim) {
-  const auto pos = field(sim, "position"), vel = field(sim, "velocity"),
-             mass = field(sim, "mass"), mat = field(sim, "material");
+  const auto pos = field(sim, "position"), vel = field(sim, "velocity"), mass = field(sim, "mass"),
+             mat = field(sim, "material");
   Motion3D b;
   const std::size_t n = sim.particle_count();
   for (std::size_t p = 0; p < n; ++p) {
     if (mat.at(p) != 0) continue;
     b.m += mass.at(p);
-    for (int c = 0; c < 3; ++c) b.x[c] += mass.at(p) * pos.at(p, c), b.v[c] += mass.at(p) * vel.at(p, c);
+    for (int c = 0; c < 3; ++c)
+      b.x[c] += mass.at(p) * pos.at(p, c), b.v[c] += mass.at(p) * vel.at(p, c);
   }
   for (int c = 0; c < 3; ++c) b.x[c] /= b.m, b.v[c] /= b.m;
   std::array<double, 3> L{};
@@ -485,14 +485,13 @@ Incline3D run_incline_3d(const std::string& body, double mu,
   const double G = 200.0, theta = std::numbers::pi / 6;
   const double gt = G * std::sin(theta), gn = -G * std::cos(theta);
   const bool ball = body == kBall3D;
-  overrides.insert(overrides.begin(),
-                   {"interaction[0].friction=" + num(mu),
-                    "load[0].acceleration=[" + num(gt * kSlope3D[0]) + "," +
-                        num(gt * kSlope3D[1]) + "," + num(gn) + "]",
-                    ball ? "grid.cells=[32,32,20]" : "grid.cells=[32,32,14]",
-                    ball ? "material[0].E=100.0" : "material[0].E=1000.0",
-                    ball ? "interaction[0].separation=\"position\""
-                         : "interaction[0].separation=\"displacement\""});
+  overrides.insert(overrides.begin(), {"interaction[0].friction=" + num(mu),
+                                       "load[0].acceleration=[" + num(gt * kSlope3D[0]) + "," +
+                                           num(gt * kSlope3D[1]) + "," + num(gn) + "]",
+                                       ball ? "grid.cells=[32,32,20]" : "grid.cells=[32,32,14]",
+                                       ball ? "material[0].E=100.0" : "material[0].E=1000.0",
+                                       ball ? "interaction[0].separation=\"position\""
+                                            : "interaction[0].separation=\"displacement\""});
   auto sim = testing::make_from_text(kFloor3D + body, overrides);
   Incline3D r;
   r.G = G, r.theta = theta;
@@ -517,11 +516,12 @@ Incline3D run_incline_3d(const std::string& body, double mu,
   for (int c = 0; c < 3; ++c)
     r.accel[c] = slope(t, v[c]), r.spin_accel[c] = slope(t, w[c]), r.reaction[c] /= rows;
   r.slide = std::hypot(m.x[0] - m0.x[0], m.x[1] - m0.x[1]);
-  note("3D %s mu %.2f: a (%.4f, %.4f, %.4f), alpha (%.4f, %.4f, %.4f), R %.4f, slide %.5f mm, "
-       "sink %.5f mm, floor reaction (%.5f, %.5f, %.5f) N, m G %.5f N",
-       ball ? "ball" : "block", mu, r.accel[0], r.accel[1], r.accel[2], r.spin_accel[0],
-       r.spin_accel[1], r.spin_accel[2], r.radius, r.slide, r.sink, r.reaction[0], r.reaction[1],
-       r.reaction[2], r.mass * G);
+  note(
+      "3D %s mu %.2f: a (%.4f, %.4f, %.4f), alpha (%.4f, %.4f, %.4f), R %.4f, slide %.5f mm, "
+      "sink %.5f mm, floor reaction (%.5f, %.5f, %.5f) N, m G %.5f N",
+      ball ? "ball" : "block", mu, r.accel[0], r.accel[1], r.accel[2], r.spin_accel[0],
+      r.spin_accel[1], r.spin_accel[2], r.radius, r.slide, r.sink, r.reaction[0], r.reaction[1],
+      r.reaction[2], r.mass * G);
   return r;
 }
 
