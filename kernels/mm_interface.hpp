@@ -61,35 +61,20 @@ Traction<Real> evaluate_traction(const PairParams<Real>& pp, Real delta_n, Real 
 }
 
 // ---------------------------------------------------------------- h⊥ and area
-// h⊥ (P-21, P-22 method 1): V_cell / (h1 h2) with h1, h2 the distances from the node to
-// the ellipsoid Σ x_k²/Δx_k² = 1 along t and n × t. Equals Δx on a regular mesh.
-template <class Real>
-Real h_perp_2d(const VecD<2, Real>& n, const std::array<Real, 3>& h) {
-  return std::sqrt(n[0] * n[0] * h[0] * h[0] + n[1] * n[1] * h[1] * h[1]);
-}
-
-template <class Real>
-Real h_perp_3d(const VecD<3, Real>& n, const VecD<3, Real>& t, const std::array<Real, 3>& h) {
-  const VecD<3, Real> s{n[1] * t[2] - n[2] * t[1], n[2] * t[0] - n[0] * t[2],
-                        n[0] * t[1] - n[1] * t[0]};
-  Real sum_t = 0, sum_s = 0;
-  for (int k = 0; k < 3; ++k) {
-    const Real inv_h2 = Real(1) / (h[k] * h[k]);
-    sum_t += t[k] * t[k] * inv_h2;
-    sum_s += s[k] * s[k] * inv_h2;
-  }
-  return h[0] * h[1] * h[2] * std::sqrt(sum_t * sum_s);
-}
-
-// D-generic entry: t is ignored in 2D.
+// h⊥ (P-21, P-22 method 1): V_cell / (h1 h2) with h1, h2 the radii of the ellipsoid
+// Σ x_k²/Δx_k² = 1 along two tangents of the plane ⟂ n. Taken along the principal axes
+// of that section (an ellipse of area π h1 h2 = π V_cell / |diag(Δx) n|), this is
+//   h⊥ = sqrt(Σ_k n_k² Δx_k²),
+// the paper's 2D formula in any dimension: V_cell = h⊥ A_c holds exactly for the
+// section, and h⊥ depends on n alone. The paper's 3D form with t along the tangential
+// opening gives a larger h⊥ for any other t (up to 25 % for Δy = 2Δx), so the interface
+// area, force and energy would change with the slip direction (docs/multimaterial.md §6).
+// Equals Δx on a regular mesh.
 template <int D, class Real>
-Real h_perp(const VecD<D, Real>& n, const VecD<D, Real>& t, const std::array<Real, 3>& h) {
-  if constexpr (D == 2) {
-    (void)t;
-    return h_perp_2d<Real>(n, h);
-  } else {
-    return h_perp_3d<Real>(n, t, h);
-  }
+Real h_perp(const VecD<D, Real>& n, const std::array<Real, 3>& h) {
+  Real sum = 0;
+  for (int k = 0; k < D; ++k) sum += n[k] * n[k] * h[k] * h[k];
+  return std::sqrt(sum);
 }
 
 // Contact area (P-20): A_i = t sqrt(2 Ω_i min(Ω_a, Ω_b)) / h⊥ in 2D (t = `thickness`),

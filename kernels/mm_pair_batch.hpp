@@ -253,7 +253,7 @@ template <NormalMethod M, Law L, bool UseDf, int D, class Real>
       }
       for (int d = 0; d < D; ++d) t[d] = delta_t > 0 ? opening_t[d] * inv_len : perpendicular[d];
     }
-    const Real hp = h_perp<D, Real>(n, t, h);
+    const Real hp = h_perp<D, Real>(n, h);
     const Real dn = position_method ? delta_n - contact_offset * hp : delta_n;
     for (int d = 0; d < D; ++d) B.n[d][i] = valid ? n[d] : Real(0);
     B.dn[i] = valid ? dn : Real(0);

@@ -289,7 +289,7 @@ PairGeometry<D, Real> pair_geometry(const MaterialSide<D, Real>& a, const Materi
   G.delta_t = std::sqrt(
       resolved_opening_squared(dot<D, Real>(opening_t, opening_t), dot<D, Real>(delta, delta)));
   G.t = tangent_or_perpendicular<D, Real>(opening_t, G.delta_t, G.n);
-  G.h_perp = mmpm::h_perp<D, Real>(G.n, G.t, h);
+  G.h_perp = mmpm::h_perp<D, Real>(G.n, h);
   G.valid = true;
   return G;
 }

@@ -485,37 +485,73 @@ TEST(MultimaterialGeometry, HPerpEqualsCellSizeOnRegularMesh) {
   for (int k = 0; k < 500; ++k) {
     const auto n3 =
         mmpm::mm_detail::normalized_or_zero<3, double>({gauss(rng), gauss(rng), gauss(rng)});
-    const auto t3 = mmpm::tangent_or_perpendicular<3, double>({0, 0, 0}, 0.0, n3);
-    EXPECT_NEAR(mmpm::h_perp_3d<double>(n3, t3, {0.7, 0.7, 0.7}), 0.7, 1e-14);
+    EXPECT_NEAR((mmpm::h_perp<3, double>(n3, {0.7, 0.7, 0.7})), 0.7, 1e-14);
     const auto n2 = mmpm::mm_detail::normalized_or_zero<2, double>({gauss(rng), gauss(rng)});
-    EXPECT_NEAR(mmpm::h_perp_2d<double>(n2, {0.7, 0.7, 1}), 0.7, 1e-14);
+    EXPECT_NEAR((mmpm::h_perp<2, double>(n2, {0.7, 0.7, 1})), 0.7, 1e-14);
   }
 }
 
+// h⊥ = V_cell / (h1 h2) with h1 h2 the product of the semi-axes of the section of the
+// ellipsoid Σ x_k²/Δx_k² = 1 by the plane ⟂ n (docs/multimaterial.md §6). Measured
+// numerically: the section's radius r(φ) by bisection along cos φ t + sin φ s, its area
+// ½ ∮ r² dφ (trapezoids, 4096 intervals, exact to round-off for this periodic smooth
+// integrand) = π h1 h2. Tolerance 1e-10 relative. The paper's 3D form, with h1 and h2
+// along an arbitrary tangent t and n × t, is never below it, and equals it only along
+// the section's principal axes (the extremes of r(φ)): checked too, since that is the
+// direction dependence the section form removes. 2D: V_cell = Δx Δy, one radius.
 TEST(MultimaterialGeometry, HPerpMatchesNumericEllipsoid) {
-  // h⊥ = V_cell / (h1 h2), h1 and h2 measured on the ellipsoid numerically (bisection,
-  // converged to round-off); tolerance 1e-10 relative. 2D: V_cell = Δx Δy, one tangent.
   std::mt19937 rng(5);
   std::normal_distribution<double> gauss;
   const std::array<double, 3> h{0.5, 1.0, 2.0};
-  for (int k = 0; k < 300; ++k) {
+  const double V = h[0] * h[1] * h[2], pi = std::numbers::pi;
+  for (int k = 0; k < 100; ++k) {
     const auto n =
         mmpm::mm_detail::normalized_or_zero<3, double>({gauss(rng), gauss(rng), gauss(rng)});
-    // A random tangent: project a random vector onto the plane ⟂ n.
+    // A random tangent t, and s = n × t.
     mmpm::VecD<3, double> r{gauss(rng), gauss(rng), gauss(rng)};
     const double rn = r[0] * n[0] + r[1] * n[1] + r[2] * n[2];
     const auto t = mmpm::mm_detail::normalized_or_zero<3, double>(
         {r[0] - rn * n[0], r[1] - rn * n[1], r[2] - rn * n[2]});
     const std::array<double, 3> s{n[1] * t[2] - n[2] * t[1], n[2] * t[0] - n[0] * t[2],
                                   n[0] * t[1] - n[1] * t[0]};
-    const double numeric =
-        h[0] * h[1] * h[2] / (ellipsoid_distance<3>(t, h) * ellipsoid_distance<3>(s, h));
-    EXPECT_NEAR(mmpm::h_perp_3d<double>(n, t, h) / numeric, 1.0, 1e-10);
+    auto along = [&](double phi) {
+      const double c = std::cos(phi), si = std::sin(phi);
+      return std::array<double, 3>{c * t[0] + si * s[0], c * t[1] + si * s[1],
+                                   c * t[2] + si * s[2]};
+    };
+    const int intervals = 4096;
+    double half_area = 0, r_min = 1e300, phi_min = 0;
+    for (int q = 0; q < intervals; ++q) {
+      const double phi = 2 * pi * q / intervals;
+      const double rq = ellipsoid_distance<3>(along(phi), h);
+      half_area += rq * rq;
+      if (rq < r_min) r_min = rq, phi_min = phi;
+    }
+    const double area = 0.5 * half_area * (2 * pi / intervals);
+    const double hp = mmpm::h_perp<3, double>(n, h);
+    EXPECT_NEAR(hp / (V / (area / pi)), 1.0, 1e-10) << "n = " << n[0] << " " << n[1] << " " << n[2];
+    const double paper_t = V / (ellipsoid_distance<3>(t, h) * ellipsoid_distance<3>(s, h));
+    EXPECT_GE(paper_t, hp * (1 - 1e-12));
+    // Along the principal axes (the shortest radius, refined by a golden-section search
+    // around the sampled minimum, and the one 90 degrees from it) the two forms agree.
+    double a = phi_min - 2 * pi / intervals, b = phi_min + 2 * pi / intervals;
+    const double g = 0.5 * (std::sqrt(5.0) - 1);
+    for (int it = 0; it < 100; ++it) {
+      const double c = b - g * (b - a), d = a + g * (b - a);
+      if (ellipsoid_distance<3>(along(c), h) < ellipsoid_distance<3>(along(d), h))
+        b = d;
+      else
+        a = c;
+    }
+    const double phi_p = 0.5 * (a + b);
+    const double principal = V / (ellipsoid_distance<3>(along(phi_p), h) *
+                                  ellipsoid_distance<3>(along(phi_p + pi / 2), h));
+    EXPECT_NEAR(principal / hp, 1.0, 1e-8);
 
     const auto n2 = mmpm::mm_detail::normalized_or_zero<2, double>({gauss(rng), gauss(rng)});
     const std::array<double, 2> t2{-n2[1], n2[0]};
     const double numeric2 = h[0] * h[1] / ellipsoid_distance<2>(t2, h);
-    EXPECT_NEAR(mmpm::h_perp_2d<double>(n2, h) / numeric2, 1.0, 1e-10);
+    EXPECT_NEAR((mmpm::h_perp<2, double>(n2, h)) / numeric2, 1.0, 1e-10);
   }
 }
 
