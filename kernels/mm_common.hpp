@@ -36,6 +36,10 @@ struct PairParams {
   NormalMethod normal_method = NormalMethod::mvg;
   std::array<Real, 3> normal_vector{1, 0, 0};  // specified normal, from `first_field` to the other
   std::array<Real, 3> radial_center{0, 0, 0};  // radial normal n ∝ x_i − c, from `first_field` out
+  // Unit axis of a cylindrical inclusion (3D): the radial normal drops its
+  // component along it. Zero: radial about the point (the subtraction is
+  // then exactly nothing).
+  std::array<Real, 3> radial_axis{0, 0, 0};
   // Field the specified / radial normal points away from (the scene's materials[0]).
   // When the pass treats the other field as `a`, those normals are negated (n runs a → b).
   int first_field = -1;

@@ -59,13 +59,29 @@ VecD<D, Real> normal_specified(const std::array<Real, 3>& vector, Real sign) {
   return mm_detail::normalized_or_zero<D, Real>(n);
 }
 
-// SN radial: n ∝ x_i − c (spherical / cylindrical inclusion `first_field` at c).
+// SN radial: n ∝ x_i − c (spherical inclusion, or a disk in 2D, `first_field` at c),
+// or, with a unit `axis` (3D), n ∝ r − (r·a) a with r = x_i − c: a cylindrical
+// inclusion (a fibre) along the line through c. A zero axis subtracts exactly 0.
+template <int D, class Real>
+VecD<D, Real> radial_direction(const std::array<Real, 3>& node_position,
+                               const std::array<Real, 3>& center, const std::array<Real, 3>& axis,
+                               Real sign) {
+  VecD<D, Real> r;
+  Real along = 0;
+  for (int d = 0; d < D; ++d) {
+    r[d] = sign * (node_position[d] - center[d]);
+    along += r[d] * axis[d];
+  }
+  for (int d = 0; d < D; ++d) r[d] -= along * axis[d];
+  return r;
+}
+
 template <int D, class Real>
 VecD<D, Real> normal_radial(const std::array<Real, 3>& node_position,
-                            const std::array<Real, 3>& center, Real sign) {
-  VecD<D, Real> n;
-  for (int d = 0; d < D; ++d) n[d] = sign * (node_position[d] - center[d]);
-  return mm_detail::normalized_or_zero<D, Real>(n);
+                            const std::array<Real, 3>& center, const std::array<Real, 3>& axis,
+                            Real sign) {
+  return mm_detail::normalized_or_zero<D, Real>(
+      radial_direction<D, Real>(node_position, center, axis, sign));
 }
 
 // The squared tangential opening |δ − (δ·n)n|² (P-15) when it is an opening, 0 when

@@ -209,9 +209,9 @@ template <NormalMethod M, Law L, bool UseDf, int D, class Real>
       for (int d = 0; d < D; ++d) u[d] = sign * pp.normal_vector[d];
       n = unit_or_zero<D, Real>(u);
     } else if constexpr (M == NormalMethod::radial) {
-      VecD<D, Real> u;
-      for (int d = 0; d < D; ++d) u[d] = sign * (B.x[d][i] - pp.radial_center[d]);
-      n = unit_or_zero<D, Real>(u);
+      const std::array<Real, 3> x{B.x[0][i], B.x[1][i], D == 3 ? B.x[D - 1][i] : Real(0)};
+      n = unit_or_zero<D, Real>(
+          radial_direction<D, Real>(x, pp.radial_center, pp.radial_axis, sign));
     } else {  // mvg (and rigid, which is mvg without a rigid partner)
       const VecD<D, Real> ga = lane<D, Real>(B.g[0][0], i), gb = lane<D, Real>(B.g[1][0], i);
       const bool use_a = dot<D, Real>(ga, ga) >= dot<D, Real>(gb, gb);

@@ -261,7 +261,7 @@ VecD<D, Real> interface_normal(const PairParams<Real>& pp, const MaterialSide<D,
     case NormalMethod::specified:
       return normal_specified<D, Real>(pp.normal_vector, sign);
     case NormalMethod::radial:
-      return normal_radial<D, Real>(node_position, pp.radial_center, sign);
+      return normal_radial<D, Real>(node_position, pp.radial_center, pp.radial_axis, sign);
     case NormalMethod::rigid:  // RMVG; without a rigid partner it falls back to MVG
       if (b_is_rigid) return normal_rigid<D, Real>(b.g);
       return normal_mvg<D, Real>(a.g, b.g);

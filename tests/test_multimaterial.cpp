@@ -417,15 +417,27 @@ TEST(MultimaterialNormals, TiltedInterfaceWithinTwoDegrees) {
 }
 
 TEST(MultimaterialNormals, RadialSpecifiedAndRigid) {
-  const std::array<double, 3> center{1, 1, 0}, node{4, 5, 0};
-  const auto r = mmpm::normal_radial<2, double>(node, center, 1.0);
+  const std::array<double, 3> center{1, 1, 0}, node{4, 5, 0}, point{0, 0, 0};
+  const auto r = mmpm::normal_radial<2, double>(node, center, point, 1.0);
   EXPECT_NEAR(r[0], 0.6, kTol);
   EXPECT_NEAR(r[1], 0.8, kTol);
-  const auto r_in = mmpm::normal_radial<2, double>(node, center, -1.0);  // a is the matrix
+  const auto r_in = mmpm::normal_radial<2, double>(node, center, point, -1.0);  // a: matrix
   EXPECT_NEAR(r_in[0], -0.6, kTol);
-  const auto r3 = mmpm::normal_radial<3, double>({1, 3, 3}, {0, 1, 1}, 1.0);
+  const auto r3 = mmpm::normal_radial<3, double>({1, 3, 3}, {0, 1, 1}, point, 1.0);
   EXPECT_NEAR(r3[0], 1.0 / 3.0, kTol);
   EXPECT_NEAR(r3[2], 2.0 / 3.0, kTol);
+  // A fibre along (0, 0, 1) through (0, 1, 1): the normal at (1, 3, 3) drops its z part,
+  // (1, 2, 0) / sqrt 5, and along (1, 1, 1) / sqrt 3 through the origin the normal at
+  // (2, 0, 1) is (2, 0, 1) - 1 (1, 1, 1) = (1, -1, 0), over sqrt 2.
+  const auto f3 = mmpm::normal_radial<3, double>({1, 3, 3}, {0, 1, 1}, {0, 0, 1}, 1.0);
+  EXPECT_NEAR(f3[0], 1.0 / std::sqrt(5.0), kTol);
+  EXPECT_NEAR(f3[1], 2.0 / std::sqrt(5.0), kTol);
+  EXPECT_EQ(f3[2], 0.0);
+  const double a = 1.0 / std::sqrt(3.0);
+  const auto g3 = mmpm::normal_radial<3, double>({2, 0, 1}, {0, 0, 0}, {a, a, a}, -1.0);
+  EXPECT_NEAR(g3[0], -1.0 / std::sqrt(2.0), kTol);
+  EXPECT_NEAR(g3[1], 1.0 / std::sqrt(2.0), kTol);
+  EXPECT_NEAR(g3[2], 0.0, kTol);
   const auto s = mmpm::normal_specified<2, double>({0, 2, 0}, -1.0);
   EXPECT_NEAR(s[1], -1.0, kTol);
   // Rigid b on x > x0 has its outward gradient along -x (P-33): n = +x from a to b.

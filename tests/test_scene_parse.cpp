@@ -329,6 +329,7 @@ Dn = 100
 Dt = 1e2
 normal = "radial"
 center = [100, 100, 100]
+axis = [0, 0, 2]
 
 [[boundary]]
 where = "x_min"
@@ -530,6 +531,7 @@ TEST(SceneParseValid, Scene3D) {
   ASSERT_EQ(s.interactions.size(), 1u);
   EXPECT_EQ(s.interactions[0].normal, NormalMethod::radial);
   expect_vec(s.interactions[0].center, 100, 100, 100);
+  expect_vec(s.interactions[0].radial_axis, 0, 0, 1);  // normalised
   EXPECT_DOUBLE_EQ(s.interactions[0].Dn, 100.0);
   ASSERT_EQ(s.boundaries.size(), 3u);
   EXPECT_EQ(s.boundaries[1].face_axis, 2);
@@ -941,6 +943,14 @@ TEST(SceneParseErrors, InteractionValues) {
                         {">= 0", "\"perfect\""});
   expect_mutation_error("Dn = \"perfect\"", "Dn = \"stiff\"", "interaction[0].Dn",
                         {"got \"stiff\""});
+  inter("axis = [0.0, 0.0, 1.0]", "interaction[0].axis", {"applies to normal = \"radial\" only"});
+  const Mutation in2d =
+      mutate(kBase, "Dt = 5.0\n",
+             "Dt = 5.0\nnormal = \"radial\"\ncenter = [1.0, 1.0]\naxis = [0.0, 1.0]\n");
+  expect_error(in2d.text, in2d.line + 3, "interaction[0].axis", {"applies in 3D only"});
+  const Mutation zero = mutate(kScene3D, "center = [100, 100, 100]\naxis = [0, 0, 2]",
+                               "center = [100, 100, 100]\naxis = [0, 0, 0]");
+  expect_error(zero.text, zero.line + 1, "interaction[0].axis", {"non-zero direction"});
   const Mutation spec = mutate(kBase, "Dt = 5.0\n", "Dt = 5.0\nnormal = \"specified\"\n");
   expect_error(spec.text, line_of(spec.text, "[[interaction]]"), "interaction[0].normal_vector",
                {"missing required key"});

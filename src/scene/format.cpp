@@ -234,6 +234,8 @@ void write_interaction(Writer& w, const InteractionSpec& in) {
   w.word("normal", in.normal);
   w.vec("normal_vector", in.normal_vector);
   w.vec("center", in.center);
+  // Read only with the radial normal in 3D (parse.cpp rejects it otherwise).
+  if (in.radial_axis != Vec3{0, 0, 0}) w.vec("axis", in.radial_axis);
   w.word("separation", in.separation);
   w.num("min_volume", in.min_volume);
   // Read only with the position method (parse.cpp rejects it otherwise).

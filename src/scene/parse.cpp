@@ -1078,8 +1078,8 @@ class SceneReader {
   // ------------------------------------------------------- [[interaction]]
   void add_interaction(const Table& t) {
     t.only({"materials", "law", "friction", "Dn", "Dt", "traction_law", "Dn_compression", "normal",
-            "normal_vector", "center", "separation", "contact_offset", "min_volume", "force_limit",
-            "integration"});
+            "normal_vector", "center", "axis", "separation", "contact_offset", "min_volume",
+            "force_limit", "integration"});
     InteractionSpec in;
     in.where = t.where();
     const Field mats = t.need("materials");
@@ -1188,6 +1188,15 @@ class SceneReader {
     if (auto f = radial ? std::optional(t.need("center", "normal = \"radial\" needs it"))
                         : t.get("center")) {
       in.center = f->vec(dim());
+    }
+    // A cylindrical inclusion in 3D (a fibre): the radial normal about the
+    // line through `center` along `axis`, n ∝ (x − c) − ((x − c)·a) a.
+    if (auto f = t.get("axis")) {
+      if (!radial) f->fail("axis applies to normal = \"radial\" only");
+      if (dim() != 3)
+        f->fail("axis applies in 3D only (in 2D the radial normal is already about the out-of-plane "
+                "axis through center)");
+      in.radial_axis = normalized(*f, f->vec(3));
     }
     if (in.normal == NormalMethod::rigid && a.type != MaterialType::rigid &&
         b.type != MaterialType::rigid) {

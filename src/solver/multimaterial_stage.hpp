@@ -39,6 +39,7 @@ class MultimaterialStage {
       for (int d = 0; d < 3; ++d) {
         pp.normal_vector[d] = Real(it.normal_vector[d]);
         pp.radial_center[d] = Real(it.center[d]);
+        pp.radial_axis[d] = Real(it.radial_axis[d]);
       }
       pp.first_field = -1;
       for (std::size_t m = 0; m < scene.materials.size(); ++m)
