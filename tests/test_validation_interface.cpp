@@ -822,7 +822,8 @@ TEST(ValidationInterface, ExtremesExactIntegrationStable) {
 // plane strain; in 3D as a slab 0.2 mm thick along the fibre, both z faces
 // held in z (plane strain), with `normal = "radial"`, `axis = [0, 0, 1]`.
 // Every 3D particle has a 2D twin at the same (x, y) and the slab's z
-// columns see the same fields, so the 3D run must be the 2D run: in-plane
+// columns see the same fields, so the 3D run must be the 2D run (and so must
+// the same slab turned to run along x, kFibre3DAlongX): in-plane
 // displacements within 1e-9 of the largest, u_z = 0, strain, interface
 // energy and work per thickness within 1e-9 (measured: 3e-16 and 6
 // digits). Without the axis the 3D normal points from the point (0, 0, 0),
@@ -965,40 +966,131 @@ displacement = [0.0, 0.005, 0.0]
 ramp         = 0.003
 )";
 
-TEST(ValidationInterface, FibreIn3DWithARadialAxisIsThe2DPlaneStrainCell) {
-  auto plane = testing::make_from_text(kFibre2D);
-  auto slab = testing::make_from_text(kFibre3D);
-  run_until(*plane, 0.02);
-  run_until(*slab, 0.02);
-  const State a = state_of(*plane), b = state_of(*slab);
-  double largest = 0, worst = 0, worst_z = 0;
-  for (std::size_t p = 0; p < plane->particle_count(); ++p)
+// The fibre slab again with the fibre along x: the cylinder body's and the
+// normal's `axis = [1, 0, 0]`, every coordinate of kFibre3D cycled (x, y, z)
+// -> (z, x, y). Same checks, with the 2D (x, y) as the slab's (y, z).
+const std::string kFibre3DAlongX = R"([simulation]
+dimension = 3
+end_time  = 0.02
+cfl       = 0.5
+flip      = 0.99
+[grid]
+origin  = [-0.2, -0.1, -0.1]
+cell    = [0.1, 0.1, 0.1]
+cells   = [6, 13, 13]
+shape   = "gimp"
+damping = 1500.0
+[[material]]
+name    = "glass"
+type    = "isotropic"
+density = 2.5e-3
+E       = 70000.0
+nu      = 0.25
+[[material]]
+name    = "polymer"
+type    = "isotropic"
+density = 1.2e-3
+E       = 2400.0
+nu      = 0.33
+[[body]]
+name     = "matrix"
+material = "polymer"
+shape    = "box"
+min      = [0.0, 0.0, 0.0]
+max      = [0.2, 1.0, 1.0]
+particles_per_cell = 2
+[[body]]
+name     = "fibre"
+material = "glass"
+shape    = "cylinder"
+center   = [0.0, 0.0, 0.0]
+radius   = 0.6
+length   = 0.2
+axis     = [1.0, 0.0, 0.0]
+clip     = { min = [0.0, 0.0, 0.0], max = [0.2, 1.0, 1.0] }
+particles_per_cell = 2
+[[interaction]]
+materials   = ["glass", "polymer"]
+law         = "interface"
+Dn          = 1.0e3
+Dt          = 1.0e4
+normal      = "radial"
+center      = [0.0, 0.0, 0.0]
+axis        = [1.0, 0.0, 0.0]
+separation  = "displacement"
+[[boundary]]
+where = { min = [-0.2, -0.1, -0.1], max = [0.4, 0.0, 1.2] }
+fix   = ["y"]
+[[boundary]]
+where = { min = [-0.2, -0.1, -0.1], max = [0.4, 1.2, 0.0] }
+fix   = ["z"]
+[[boundary]]
+where = { min = [-0.2, -0.1, -0.1], max = [0.0, 1.2, 1.2] }
+fix   = ["x"]
+[[boundary]]
+where = { min = [0.2, -0.1, -0.1], max = [0.4, 1.2, 1.2] }
+fix   = ["x"]
+[[boundary]]
+where        = { min = [-0.2, 1.0, -0.1], max = [0.4, 1.2, 1.2] }
+fix          = ["y"]
+displacement = [0.0, 0.005, 0.0]
+ramp         = 0.003
+[[boundary]]
+where        = { min = [-0.2, -0.1, 1.0], max = [0.4, 1.2, 1.2] }
+fix          = ["z"]
+displacement = [0.0, 0.0, 0.005]
+ramp         = 0.003
+)";
+
+// The slab's particles against their 2D twins: `in_plane` names the slab's
+// two section axes (the 2D x and y), the third is along the fibre.
+void expect_slab_is_the_plane_cell(const State& a, std::size_t plane_count, const State& b,
+                                   std::size_t slab_count, std::array<int, 2> in_plane, int along,
+                                   const char* label) {
+  double largest = 0, worst = 0, worst_along = 0;
+  for (std::size_t p = 0; p < plane_count; ++p)
     largest = std::max({largest, std::abs(a.disp.at(p, 0)), std::abs(a.disp.at(p, 1))});
   std::size_t twins = 0;
-  for (std::size_t q = 0; q < slab->particle_count(); ++q) {
-    for (std::size_t p = 0; p < plane->particle_count(); ++p) {
-      if (std::abs(a.x0(p, 0) - b.x0(q, 0)) > 1e-9 || std::abs(a.x0(p, 1) - b.x0(q, 1)) > 1e-9)
+  for (std::size_t q = 0; q < slab_count; ++q) {
+    for (std::size_t p = 0; p < plane_count; ++p) {
+      if (std::abs(a.x0(p, 0) - b.x0(q, in_plane[0])) > 1e-9 ||
+          std::abs(a.x0(p, 1) - b.x0(q, in_plane[1])) > 1e-9)
         continue;
       ++twins;
-      worst = std::max({worst, std::abs(a.disp.at(p, 0) - b.disp.at(q, 0)),
-                        std::abs(a.disp.at(p, 1) - b.disp.at(q, 1))});
-      worst_z = std::max(worst_z, std::abs(b.disp.at(q, 2)));
+      worst = std::max({worst, std::abs(a.disp.at(p, 0) - b.disp.at(q, in_plane[0])),
+                        std::abs(a.disp.at(p, 1) - b.disp.at(q, in_plane[1]))});
+      worst_along = std::max(worst_along, std::abs(b.disp.at(q, along)));
       break;
     }
   }
   const double t = 0.2;
   std::printf(
-      "[fibre] 2D: U %.6e U_int %.6e W %.6e; 3D / t: U %.6e U_int %.6e W %.6e; worst in-plane "
-      "difference %.2e of %.3e, |u_z| %.1e\n",
-      a.e.strain, a.e.interface, a.e.external_work, b.e.strain / t, b.e.interface / t,
-      b.e.external_work / t, worst, largest, worst_z);
-  EXPECT_EQ(twins, slab->particle_count()) << "a 3D particle without a 2D twin";
-  EXPECT_LT(worst, 1e-9 * largest);
-  EXPECT_LT(worst_z, 1e-9 * largest);
+      "[fibre %s] 2D: U %.6e U_int %.6e W %.6e; 3D / t: U %.6e U_int %.6e W %.6e; worst "
+      "in-plane difference %.2e of %.3e, |u along the fibre| %.1e\n",
+      label, a.e.strain, a.e.interface, a.e.external_work, b.e.strain / t, b.e.interface / t,
+      b.e.external_work / t, worst, largest, worst_along);
+  EXPECT_EQ(twins, slab_count) << label << ": a 3D particle without a 2D twin";
+  EXPECT_LT(worst, 1e-9 * largest) << label;
+  EXPECT_LT(worst_along, 1e-9 * largest) << label;
+  EXPECT_NEAR(b.e.strain / t / a.e.strain, 1.0, 1e-9) << label;
+  EXPECT_NEAR(b.e.interface / t / a.e.interface, 1.0, 1e-9) << label;
+  EXPECT_NEAR(b.e.external_work / t / a.e.external_work, 1.0, 1e-9) << label;
+}
+
+TEST(ValidationInterface, FibreIn3DWithARadialAxisIsThe2DPlaneStrainCell) {
+  auto plane = testing::make_from_text(kFibre2D);
+  auto slab = testing::make_from_text(kFibre3D);
+  auto slab_x = testing::make_from_text(kFibre3DAlongX);
+  run_until(*plane, 0.02);
+  run_until(*slab, 0.02);
+  run_until(*slab_x, 0.02);
+  const State a = state_of(*plane);
   EXPECT_GT(a.e.interface, 0.1 * a.e.strain) << "the interface must matter";
-  EXPECT_NEAR(b.e.strain / t / a.e.strain, 1.0, 1e-9);
-  EXPECT_NEAR(b.e.interface / t / a.e.interface, 1.0, 1e-9);
-  EXPECT_NEAR(b.e.external_work / t / a.e.external_work, 1.0, 1e-9);
+  expect_slab_is_the_plane_cell(a, plane->particle_count(), state_of(*slab), slab->particle_count(),
+                                {0, 1}, 2, "along z");
+  expect_slab_is_the_plane_cell(a, plane->particle_count(), state_of(*slab_x),
+                                slab_x->particle_count(), {1, 2}, 0, "along x");
+  const double t = 0.2;
 
   // The same slab with the radial normal about the point (0, 0, 0).
   std::string point = kFibre3D;

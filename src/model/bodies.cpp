@@ -7,8 +7,10 @@
 #include <cstdint>
 #include <numbers>
 #include <string>
+#include <tuple>
 #include <vector>
 
+#include "scene/cylinder.hpp"
 #include "scene/error.hpp"
 
 namespace mmpm {
@@ -71,8 +73,7 @@ std::pair<Vec3, Vec3> bounds(const BodySpec& b, int dim) {
       for (int d = 0; d < dim; ++d) lo[d] = b.center[d] - b.radius, hi[d] = b.center[d] + b.radius;
       break;
     case BodyShape::cylinder:
-      for (int d = 0; d < 2; ++d) lo[d] = b.center[d] - b.radius, hi[d] = b.center[d] + b.radius;
-      lo[2] = b.center[2], hi[2] = b.center[2] + b.length;
+      std::tie(lo, hi) = cylinder_bounds(b);
       break;
     case BodyShape::polygon: {
       const Vec3 c = box_center(b);
@@ -154,11 +155,8 @@ bool inside_body(const BodySpec& b, const Vec3& x, int dim) {
       for (int d = 0; d < dim; ++d) r2 += (x[d] - b.center[d]) * (x[d] - b.center[d]);
       return r2 <= b.radius * b.radius;
     }
-    case BodyShape::cylinder: {
-      const double r2 =
-          (x[0] - b.center[0]) * (x[0] - b.center[0]) + (x[1] - b.center[1]) * (x[1] - b.center[1]);
-      return r2 <= b.radius * b.radius && x[2] >= b.center[2] && x[2] <= b.center[2] + b.length;
-    }
+    case BodyShape::cylinder:
+      return inside_cylinder(b, x);
     case BodyShape::polygon: {
       const Vec3 u = to_body_frame(b, x);
       return inside_polygon(b.points, u[0], u[1]);

@@ -196,6 +196,7 @@ void write_body(Writer& w, const BodySpec& b, int dim) {
       w.vec("center", b.center);
       w.num("radius", b.radius);
       w.num("length", b.length);
+      w.vec("axis", b.axis);
       break;
     case BodyShape::disk:
     case BodyShape::sphere:

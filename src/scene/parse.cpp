@@ -15,6 +15,7 @@
 #include <toml.hpp>
 #include <unordered_map>
 
+#include "scene/cylinder.hpp"
 #include "scene/format.hpp"
 
 namespace mmpm {
@@ -395,14 +396,15 @@ std::vector<Vec3> outline_points(const BodySpec& b) {
       return {b.min, {b.max[0], b.min[1], b.min[2]}, b.max, {b.min[0], b.max[1], b.max[2]}};
     case BodyShape::polygon:
       return b.points;
-    case BodyShape::disk:
-    case BodyShape::sphere:
     case BodyShape::cylinder: {
+      const auto [lo, hi] = cylinder_bounds(b);
+      return {lo, hi};
+    }
+    case BodyShape::disk:
+    case BodyShape::sphere: {
       const double r = b.radius;
       const Vec3& c = b.center;
-      const double z_hi = b.shape == BodyShape::cylinder ? c[2] + b.length : c[2] + r;
-      const double z_lo = b.shape == BodyShape::cylinder ? c[2] : c[2] - r;
-      return {{c[0] - r, c[1] - r, z_lo}, {c[0] + r, c[1] + r, z_hi}};
+      return {{c[0] - r, c[1] - r, c[2] - r}, {c[0] + r, c[1] + r, c[2] + r}};
     }
   }
   return {};
@@ -902,7 +904,7 @@ class SceneReader {
         keys.insert(keys.end(), {"center", "radius"});
         break;
       case BodyShape::cylinder:
-        keys.insert(keys.end(), {"center", "radius", "length"});
+        keys.insert(keys.end(), {"center", "radius", "length", "axis"});
         break;
       case BodyShape::polygon:
         keys.push_back("points");
@@ -976,6 +978,7 @@ class SceneReader {
       }
       case BodyShape::cylinder:
         b.length = t.need("length", why).positive();
+        if (auto f = t.get("axis")) b.axis = normalized(*f, f->vec(3));
         [[fallthrough]];
       case BodyShape::disk:
       case BodyShape::sphere:

@@ -122,7 +122,8 @@ struct BodySpec {
       pivot;             // rotate about this point instead (a whole specimen of several bodies)
   Vec3 center{0, 0, 0};  // disk, sphere, cylinder
   double radius = 0.0;
-  double length = 0.0;         // cylinder (3D): along axis z from center
+  double length = 0.0;         // cylinder (3D): from center along `axis`
+  Vec3 axis{0, 0, 1};          // cylinder: unit direction
   std::vector<Vec3> points;    // polygon
   int particles_per_cell = 2;  // per direction
   Vec3 velocity{0, 0, 0};
