@@ -21,7 +21,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <functional>
+#include <iterator>
 #include <limits>
 #include <numbers>
 #include <sstream>
@@ -820,7 +822,8 @@ TEST(ValidationInterface, ExtremesExactIntegrationStable) {
 // 0.5 % strain in x and y (transverse biaxial load), damped to 0.02 ms; the
 // paper's sphere-in-cube materials and grid (0.1 mm, uGIMP, 2 ppc). In 2D
 // plane strain; in 3D as a slab 0.2 mm thick along the fibre, both z faces
-// held in z (plane strain), with `normal = "radial"`, `axis = [0, 0, 1]`.
+// held in z (plane strain), with `normal = "radial"`, `axis = [0, 0, 1]`
+// (inputs/fibre_slab.toml, the shipped scene).
 // Every 3D particle has a 2D twin at the same (x, y) and the slab's z
 // columns see the same fields, so the 3D run must be the 2D run (and so must
 // the same slab turned to run along x, kFibre3DAlongX): in-plane
@@ -894,80 +897,9 @@ fix          = ["y"]
 displacement = [0.0, 0.005]
 ramp         = 0.003
 )";
-const std::string kFibre3D = R"([simulation]
-dimension = 3
-end_time  = 0.02
-cfl       = 0.5
-flip      = 0.99
-[grid]
-origin  = [-0.1, -0.1, -0.2]
-cell    = [0.1, 0.1, 0.1]
-cells   = [13, 13, 6]
-shape   = "gimp"
-damping = 1500.0
-[[material]]
-name    = "glass"
-type    = "isotropic"
-density = 2.5e-3
-E       = 70000.0
-nu      = 0.25
-[[material]]
-name    = "polymer"
-type    = "isotropic"
-density = 1.2e-3
-E       = 2400.0
-nu      = 0.33
-[[body]]
-name     = "matrix"
-material = "polymer"
-shape    = "box"
-min      = [0.0, 0.0, 0.0]
-max      = [1.0, 1.0, 0.2]
-particles_per_cell = 2
-[[body]]
-name     = "fibre"
-material = "glass"
-shape    = "cylinder"
-center   = [0.0, 0.0, 0.0]
-radius   = 0.6
-length   = 0.2
-clip     = { min = [0.0, 0.0, 0.0], max = [1.0, 1.0, 0.2] }
-particles_per_cell = 2
-[[interaction]]
-materials   = ["glass", "polymer"]
-law         = "interface"
-Dn          = 1.0e3
-Dt          = 1.0e4
-normal      = "radial"
-center      = [0.0, 0.0, 0.0]
-axis        = [0.0, 0.0, 1.0]
-separation  = "displacement"
-[[boundary]]
-where = { min = [-0.1, -0.1, -0.2], max = [0.0, 1.2, 0.4] }
-fix   = ["x"]
-[[boundary]]
-where = { min = [-0.1, -0.1, -0.2], max = [1.2, 0.0, 0.4] }
-fix   = ["y"]
-[[boundary]]
-where = { min = [-0.1, -0.1, -0.2], max = [1.2, 1.2, 0.0] }
-fix   = ["z"]
-[[boundary]]
-where = { min = [-0.1, -0.1, 0.2], max = [1.2, 1.2, 0.4] }
-fix   = ["z"]
-[[boundary]]
-where        = { min = [1.0, -0.1, -0.2], max = [1.2, 1.2, 0.4] }
-fix          = ["x"]
-displacement = [0.005, 0.0, 0.0]
-ramp         = 0.003
-[[boundary]]
-where        = { min = [-0.1, 1.0, -0.2], max = [1.2, 1.2, 0.4] }
-fix          = ["y"]
-displacement = [0.0, 0.005, 0.0]
-ramp         = 0.003
-)";
 
 // The fibre slab again with the fibre along x: the cylinder body's and the
-// normal's `axis = [1, 0, 0]`, every coordinate of kFibre3D cycled (x, y, z)
+// normal's `axis = [1, 0, 0]`, every coordinate of inputs/fibre_slab.toml cycled (x, y, z)
 // -> (z, x, y). Same checks, with the 2D (x, y) as the slab's (y, z).
 const std::string kFibre3DAlongX = R"([simulation]
 dimension = 3
@@ -1079,7 +1011,7 @@ void expect_slab_is_the_plane_cell(const State& a, std::size_t plane_count, cons
 
 TEST(ValidationInterface, FibreIn3DWithARadialAxisIsThe2DPlaneStrainCell) {
   auto plane = testing::make_from_text(kFibre2D);
-  auto slab = testing::make_from_text(kFibre3D);
+  auto slab = make_scene("fibre_slab.toml", {});  // the shipped scene
   auto slab_x = testing::make_from_text(kFibre3DAlongX);
   run_until(*plane, 0.02);
   run_until(*slab, 0.02);
@@ -1093,8 +1025,11 @@ TEST(ValidationInterface, FibreIn3DWithARadialAxisIsThe2DPlaneStrainCell) {
   const double t = 0.2;
 
   // The same slab with the radial normal about the point (0, 0, 0).
-  std::string point = kFibre3D;
-  point.erase(point.find("axis "), point.find('\n', point.find("axis ")) - point.find("axis ") + 1);
+  std::ifstream file(input_path("fibre_slab.toml"));
+  std::string point((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  const std::size_t key = point.find("\naxis        =");  // the interaction's, not the body's
+  ASSERT_NE(key, std::string::npos);
+  point.erase(key, point.find('\n', key + 1) - key);
   auto tilted = testing::make_from_text(point);
   run_until(*tilted, 0.02);
   const double off = tilted->energies().interface / t / a.e.interface - 1;
