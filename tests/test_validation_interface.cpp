@@ -832,6 +832,20 @@ TEST(ValidationInterface, ExtremesExactIntegrationStable) {
 // digits). Without the axis the 3D normal points from the point (0, 0, 0),
 // tilts out of the plane by up to atan(0.2 / 0.6) = 18 degrees, and mixes
 // Dt into the radial opening: measured U_int +21.5 %, checked > 5 % off.
+// The glass fibre and the polymer matrix of every fibre cell below.
+const std::string kFibreMaterials = R"([[material]]
+name    = "glass"
+type    = "isotropic"
+density = 2.5e-3
+E       = 70000.0
+nu      = 0.25
+[[material]]
+name    = "polymer"
+type    = "isotropic"
+density = 1.2e-3
+E       = 2400.0
+nu      = 0.33
+)";
 const std::string kFibre2D = R"([simulation]
 dimension = 2
 plane     = "strain"
@@ -845,19 +859,7 @@ cell    = [0.1, 0.1]
 cells   = [13, 13]
 shape   = "gimp"
 damping = 1500.0
-[[material]]
-name    = "glass"
-type    = "isotropic"
-density = 2.5e-3
-E       = 70000.0
-nu      = 0.25
-[[material]]
-name    = "polymer"
-type    = "isotropic"
-density = 1.2e-3
-E       = 2400.0
-nu      = 0.33
-[[body]]
+)" + kFibreMaterials + R"([[body]]
 name     = "matrix"
 material = "polymer"
 shape    = "box"
@@ -912,19 +914,7 @@ cell    = [0.1, 0.1, 0.1]
 cells   = [6, 13, 13]
 shape   = "gimp"
 damping = 1500.0
-[[material]]
-name    = "glass"
-type    = "isotropic"
-density = 2.5e-3
-E       = 70000.0
-nu      = 0.25
-[[material]]
-name    = "polymer"
-type    = "isotropic"
-density = 1.2e-3
-E       = 2400.0
-nu      = 0.33
-[[body]]
+)" + kFibreMaterials + R"([[body]]
 name     = "matrix"
 material = "polymer"
 shape    = "box"

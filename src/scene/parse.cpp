@@ -1197,8 +1197,9 @@ class SceneReader {
     if (auto f = t.get("axis")) {
       if (!radial) f->fail("axis applies to normal = \"radial\" only");
       if (dim() != 3)
-        f->fail("axis applies in 3D only (in 2D the radial normal is already about the out-of-plane "
-                "axis through center)");
+        f->fail(
+            "axis applies in 3D only (in 2D the radial normal is already about the out-of-plane "
+            "axis through center)");
       in.radial_axis = normalized(*f, f->vec(3));
     }
     if (in.normal == NormalMethod::rigid && a.type != MaterialType::rigid &&
