@@ -140,7 +140,7 @@ struct InteractionSpec {
   double Dn_compression = std::numeric_limits<double>::infinity();  // bilinear
   NormalMethod normal = NormalMethod::mvg;
   Vec3 normal_vector{1, 0, 0};
-  Vec3 center{0, 0, 0};  // radial
+  Vec3 center{0, 0, 0};       // radial
   Vec3 radial_axis{0, 0, 0};  // radial in 3D about a line (unit), or 0: about the point `center`
   Separation separation = Separation::displacement;
   double min_volume = 0.0;      // fraction of the cell volume
