@@ -3,6 +3,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "scene/format.hpp"
 #include "scene/interaction_warning.hpp"
 #include "solver/contact_gap.hpp"
 #include "solver/simulation.hpp"
@@ -50,8 +51,7 @@ std::vector<std::string> computed_normal_warnings(const Scene& scene) {
     const bool perfect = std::isinf(it.Dn) || std::isinf(it.Dt);
     if (it.law != Law::interface || !computed || !perfect || it.min_volume > 0) continue;
     std::ostringstream m;
-    m << interaction_warning(scene, k, "normal") << "normal = \""
-      << (it.normal == NormalMethod::mvg ? "mvg" : "avg") << "\""
+    m << interaction_warning(scene, k, "normal") << "normal = \"" << scene_name(it.normal) << "\""
       << (it.normal == NormalMethod::mvg ? " (mvg is the default)" : "") << " with D"
       << (std::isinf(it.Dn) ? 'n' : 't')
       << " = \"perfect\" and min_volume = 0: where the interface meets a free edge the "
