@@ -14,6 +14,7 @@
 // --set style overrides for the variants.
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -391,32 +392,18 @@ Motion3D motion_3d(const Simulation& sim) {
       b.x[c] += mass.at(p) * pos.at(p, c), b.v[c] += mass.at(p) * vel.at(p, c);
   }
   for (int c = 0; c < 3; ++c) b.x[c] /= b.m, b.v[c] /= b.m;
-  std::array<double, 3> L{};
-  std::array<std::array<double, 3>, 3> I{};
+  Eigen::Vector3d L = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d I = Eigen::Matrix3d::Zero();  // inertia tensor about the centre of mass
   for (std::size_t p = 0; p < n; ++p) {
     if (mat.at(p) != 0) continue;
-    std::array<double, 3> r, u;
+    Eigen::Vector3d r, u;
     for (int c = 0; c < 3; ++c) r[c] = pos.at(p, c) - b.x[c], u[c] = vel.at(p, c) - b.v[c];
-    const double mp = mass.at(p), rr = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
-    L[0] += mp * (r[1] * u[2] - r[2] * u[1]);
-    L[1] += mp * (r[2] * u[0] - r[0] * u[2]);
-    L[2] += mp * (r[0] * u[1] - r[1] * u[0]);
-    for (int a = 0; a < 3; ++a)
-      for (int c = 0; c < 3; ++c) I[a][c] += mp * ((a == c ? rr : 0.0) - r[a] * r[c]);
+    L += mass.at(p) * r.cross(u);
+    I += mass.at(p) * (r.squaredNorm() * Eigen::Matrix3d::Identity() - r * r.transpose());
   }
-  // omega = I^-1 L by Cramer's rule (I is symmetric positive definite).
-  auto det = [](const std::array<std::array<double, 3>, 3>& M) {
-    return M[0][0] * (M[1][1] * M[2][2] - M[1][2] * M[2][1]) -
-           M[0][1] * (M[1][0] * M[2][2] - M[1][2] * M[2][0]) +
-           M[0][2] * (M[1][0] * M[2][1] - M[1][1] * M[2][0]);
-  };
-  const double d = det(I);
-  for (int c = 0; c < 3; ++c) {
-    auto M = I;
-    for (int a = 0; a < 3; ++a) M[a][c] = L[a];
-    b.omega[c] = det(M) / d;
-  }
-  b.radius = std::sqrt(5.0 * (I[0][0] + I[1][1] + I[2][2]) / 3.0 / (2.0 * b.m));
+  const Eigen::Vector3d omega = I.ldlt().solve(L);  // I is symmetric positive definite
+  for (int c = 0; c < 3; ++c) b.omega[c] = omega[c];
+  b.radius = std::sqrt(5.0 * I.trace() / 3.0 / (2.0 * b.m));
   return b;
 }
 

@@ -353,7 +353,9 @@ ramp     = 0.05
       for (int c = 0; c < 3; ++c) Atu[a][c] += row[a] * u.at(p, c);
     }
   }
-  // Gauss-Jordan on the 4 x 4 normal equations, three right-hand sides.
+  // Gauss-Jordan on the 4 x 4 normal equations, three right-hand sides. (Eigen's
+  // solvers here trip GCC 12's false maybe-uninitialized inside its AVX-512
+  // intrinsics, as in src/model/material.cpp, and the build is -Werror.)
   for (int k = 0; k < 4; ++k) {
     const double pivot = AtA[k][k];
     for (int b = 0; b < 4; ++b) AtA[k][b] /= pivot;
