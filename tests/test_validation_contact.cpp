@@ -517,6 +517,14 @@ Incline3D run_incline_3d(const std::string& body, double mu,
 // reaction (mu N d, -N) within 1 %, N = m G cos theta. Sticking (mu = 0.7 >
 // tan 30): no slide beyond 1 % of a cell, and the floor holds the tilted
 // weight m G (sin theta d, -cos theta) within 1 %.
+// The force on the floor, (T d, -N), each component within 1 %.
+void expect_floor_reaction(const Incline3D& r, double T, double N) {
+  for (int c = 0; c < 2; ++c)
+    EXPECT_NEAR(r.reaction[c] / (T * kSlope3D[c]), 1.0, 0.01)
+        << "tangential reaction " << c << ": " << r.reaction[c];
+  EXPECT_NEAR(r.reaction[2] / -N, 1.0, 0.01) << "normal reaction " << r.reaction[2];
+}
+
 TEST(ValidationContact, Block3DSlidesAlongASlantOfTheFloor) {
   const double mu = 0.2;
   const Incline3D r = run_incline_3d(kBlock3D, mu);
@@ -526,10 +534,7 @@ TEST(ValidationContact, Block3DSlidesAlongASlantOfTheFloor) {
   EXPECT_LT(std::abs(degrees_off_slope(r.accel)), 0.1) << "the block slid off d";
   EXPECT_LT(r.sink, 0.01 * 0.5) << "the block must stay on the floor";
   const double N = r.mass * r.G * std::cos(r.theta);
-  for (int c = 0; c < 2; ++c)
-    EXPECT_NEAR(r.reaction[c] / (mu * N * kSlope3D[c]), 1.0, 0.01)
-        << "tangential reaction " << c << ": " << r.reaction[c];
-  EXPECT_NEAR(r.reaction[2] / -N, 1.0, 0.01) << "normal reaction " << r.reaction[2];
+  expect_floor_reaction(r, mu * N, N);
 }
 
 TEST(ValidationContact, Block3DSticksWhenFrictionExceedsSlope) {
@@ -537,10 +542,7 @@ TEST(ValidationContact, Block3DSticksWhenFrictionExceedsSlope) {
   EXPECT_LT(r.slide, 0.01 * 0.5);
   EXPECT_LT(std::hypot(r.accel[0], r.accel[1]), 0.01 * r.G * std::sin(r.theta));
   const double W = r.mass * r.G;  // the floor holds the whole tilted weight
-  for (int c = 0; c < 2; ++c)
-    EXPECT_NEAR(r.reaction[c] / (W * std::sin(r.theta) * kSlope3D[c]), 1.0, 0.01)
-        << "tangential reaction " << c << ": " << r.reaction[c];
-  EXPECT_NEAR(r.reaction[2] / (-W * std::cos(r.theta)), 1.0, 0.01);
+  expect_floor_reaction(r, W * std::sin(r.theta), W * std::cos(r.theta));
 }
 
 // Ball, rolling (mu = 0.5 >= (2/7) tan theta = 0.165): a solid sphere rolls
