@@ -51,7 +51,18 @@ struct PairParams {
   Real omega_min = 0;  // ABSOLUTE nodal domain below which the node is skipped (units of grid.vol)
   bool force_limit = true;  // §4.4 (explicit integration only)
   Integration integration = Integration::explicit_;
+  // The (P-20) area on domains with the opening closed (interface law only,
+  // docs/multimaterial.md §7.1); needs g (P-33) whatever the normal.
+  bool closed_area = false;
 };
+
+// Whether a pair reads the domain gradients g (P-33): the mvg, avg and rigid
+// normals, and the closed area (docs/multimaterial.md §7.1).
+template <class Real>
+bool reads_domain_gradient(const PairParams<Real>& pp) {
+  return pp.normal_method == NormalMethod::mvg || pp.normal_method == NormalMethod::avg ||
+         pp.normal_method == NormalMethod::rigid || pp.closed_area;
+}
 
 // Everything the two passes need besides the grid.
 template <int D, class Real>

@@ -88,6 +88,33 @@ Real contact_area(Real vol_a, Real vol_b, Real h_perp_value, Real thickness) {
   return area;
 }
 
+template <class Real>
+struct ClosedDomains {
+  Real a, b;  // Ω_a', Ω_b'
+};
+
+// The nodal domains with the interface's opening closed (area = "closed",
+// docs/multimaterial.md §7.1). On the current domains (P-20) loses area as the
+// interface opens, 1.5 δ_n/h⊥ of it at a grid-line interface: the side that
+// moved away takes its domain from the node. Moving material j's particles by
+// s n changes Ω_j by s (n · g_j) (g = Σ ∇S_i(x_p) V_p, outward, P-33), so each
+// side is moved back along n by its normal displacement u_jn less a common c.
+// c is the value between u_an and u_bn nearest 0: where the reference
+// configuration lies within the opening (small motion: either side or both
+// moved) both sides return to it, which is exact to first order; under a large
+// common motion only the side that moved the farther returns, by the opening
+// and never more, so the Taylor step stays within the gap. Callers without
+// displacements (the position method) pass −dn/2 and dn/2: half the opening
+// each. A domain cannot go below 0.
+template <class Real>
+[[nodiscard]] inline ClosedDomains<Real> close_opening(Real vol_a, Real vol_b, Real gn_a, Real gn_b,
+                                                       Real u_an, Real u_bn) {
+  const Real lo = u_an < u_bn ? u_an : u_bn, hi = u_an < u_bn ? u_bn : u_an;
+  const Real c = lo > Real(0) ? lo : (hi < Real(0) ? hi : Real(0));
+  const Real closed_a = vol_a - (u_an - c) * gn_a, closed_b = vol_b - (u_bn - c) * gn_b;
+  return {closed_a > Real(0) ? closed_a : Real(0), closed_b > Real(0) ? closed_b : Real(0)};
+}
+
 // ---------------------------------------------------------------- force limit
 // Component along a direction of the largest meaningful interface force on a (P-26):
 // the force that brings a and b to the center-of-mass displacement in one step under

@@ -101,11 +101,10 @@ const char* validate_multimaterial(const GridView<D, Real>& grid, const MMConfig
       if (k < 0 || a == b) continue;
       if (!cfg.params) return "MMConfig.params is required by the pair table";
       const PairParams<Real>& pp = cfg.params[k];
-      const bool gradient = pp.normal_method == NormalMethod::mvg ||
-                            pp.normal_method == NormalMethod::avg ||
-                            pp.normal_method == NormalMethod::rigid;
+      const bool gradient = reads_domain_gradient(pp);
       for (int d = 0; d < D; ++d) {
-        if (gradient && !grid.g[d]) return "grid g is required by the mvg/avg/rigid normals";
+        if (gradient && !grid.g[d])
+          return "grid g is required by the mvg/avg/rigid normals and the closed area";
         if (pp.law == Law::interface && !grid.fi[d]) return "grid fi is required by interfaces";
         if (cfg.use_force_difference && !grid.f[d]) return "grid f is required by Δf";
       }
@@ -380,7 +379,15 @@ InteractionResult<D, Real> interact_pass_a(const MaterialSide<D, Real>& a,
 
   r.evaluated = true;
   const Traction<Real> tr = evaluate_traction(pp, dn, G.delta_t);
-  const Real area = contact_area<D, Real>(a.vol, b.vol, G.h_perp, thickness);
+  ClosedDomains<Real> vol{a.vol, b.vol};
+  if (pp.closed_area) {
+    const bool known = pp.separation != Separation::position;  // mx holds displacements
+    const Real half = Real(0.5) * dn;
+    vol = close_opening(a.vol, b.vol, dot<D, Real>(a.g, G.n), dot<D, Real>(b.g, G.n),
+                        known ? dot<D, Real>(a.mx, G.n) / a.m : -half,
+                        known ? dot<D, Real>(b.mx, G.n) / b.m : half);
+  }
+  const Real area = contact_area<D, Real>(vol.a, vol.b, G.h_perp, thickness);
   const Real m_red = reduced_mass(a.m, b.m, b_is_rigid);
   VecD<D, Real> df{};
   if (use_force_difference) df = force_difference<D, Real>(a.m, a.f, b.m, b.f, b_is_rigid);
@@ -454,7 +461,7 @@ struct NodeFields {
 // What the pairs of a configuration read besides m, p, mx, vol.
 struct PassNeeds {
   bool geometry = true;   // mx (pass B from saved geometry reads only m, Ω, p)
-  bool gradient = false;  // some pair uses the mvg / avg / rigid normal
+  bool gradient = false;  // some pair uses the mvg / avg / rigid normal, or the closed area
   bool position = false;  // some pair uses the radial normal
   bool force = false;     // Δf_i (pass A with cfg.use_force_difference)
 };
@@ -468,8 +475,7 @@ PassNeeds pass_needs(const MMConfig<D, Real>& cfg, bool pass_a) {
     if (cfg.pair[k] < 0) continue;
     const NormalMethod method = cfg.params[cfg.pair[k]].normal_method;
     needs.position |= method == NormalMethod::radial;
-    needs.gradient |=
-        method == NormalMethod::mvg || method == NormalMethod::avg || method == NormalMethod::rigid;
+    needs.gradient |= reads_domain_gradient(cfg.params[cfg.pair[k]]);
   }
   return needs;
 }
@@ -698,8 +704,7 @@ void process_chunk(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg,
     BatchNeeds bn;
     if constexpr (kPassA) {
       const NormalMethod method = B.params->normal_method;
-      bn.gradient = method == NormalMethod::mvg || method == NormalMethod::avg ||
-                    method == NormalMethod::rigid;
+      bn.gradient = reads_domain_gradient(*B.params);
       bn.position = method == NormalMethod::radial;
       bn.force = cfg.use_force_difference;
       gather_batch<D, Real>(grid, bn, B);

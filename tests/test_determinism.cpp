@@ -272,6 +272,16 @@ TEST(Determinism, ImperfectInterfaceExtrapolatedSeparation2D) {
   EXPECT_GT(r.energies.interface, 0.0);
 }
 
+// area = "closed" (docs/multimaterial.md §7.1): g scattered for a specified
+// normal, each node's domains closed on their own.
+TEST(Determinism, ImperfectInterfaceClosedArea2D) {
+  BoxScene2D s = two_materials("double", std::string(kNumericInterface) + "area = \"closed\"\n");
+  s.scheme = "MUSL";
+  const RunResult r = check_scene(s.text(), "2D gimp double", 40.0);
+  EXPECT_GT(r.counters.multimaterial_nodes, 0);
+  EXPECT_GT(r.energies.interface, 0.0);
+}
+
 TEST(Determinism, ImperfectInterfaceFloat2D) {
   const RunResult r =
       check_scene(two_materials("float", kNumericInterface).text(), "2D gimp float", 40.0);

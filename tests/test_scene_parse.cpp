@@ -232,6 +232,7 @@ contact_offset = 0.6
 min_volume = 0.75
 force_limit = false
 integration = "exact"
+area = "closed"
 
 [[interaction]]
 materials = ["platen", "wood"]
@@ -458,6 +459,7 @@ TEST(SceneParseValid, Full2DSceneInteractions) {
   EXPECT_DOUBLE_EQ(in.min_volume, 0.75);
   EXPECT_FALSE(in.force_limit);
   EXPECT_EQ(in.integration, Integration::exact);
+  EXPECT_EQ(in.area, ContactArea::closed);
   EXPECT_EQ(in.where.line, line_of(kFull2D, "[[interaction]]"));
   const InteractionSpec& fr = s.interactions[1];
   EXPECT_EQ(fr.law, Law::friction);
@@ -575,6 +577,7 @@ TEST(SceneParseValid, DefaultsAreFilled) {
   EXPECT_DOUBLE_EQ(in.min_volume, 0.0);
   EXPECT_TRUE(in.force_limit);
   EXPECT_EQ(in.integration, Integration::explicit_);
+  EXPECT_EQ(in.area, ContactArea::paper);
   EXPECT_DOUBLE_EQ(s.boundaries[0].ramp, 0.0);
   EXPECT_DOUBLE_EQ(s.loads[0].ramp, 0.0);
   EXPECT_DOUBLE_EQ(s.output.every, 0.0);
@@ -944,6 +947,14 @@ TEST(SceneParseErrors, InteractionValues) {
   expect_mutation_error("Dn = \"perfect\"", "Dn = \"stiff\"", "interaction[0].Dn",
                         {"got \"stiff\""});
   inter("axis = [0.0, 0.0, 1.0]", "interaction[0].axis", {"applies to normal = \"radial\" only"});
+  inter("area = \"open\"", "interaction[0].area",
+        {"expected one of \"paper\", \"closed\", got \"open\""});
+  const Mutation area_of_contact =
+      mutate(kBase, "law = \"interface\"\n", "law = \"frictionless\"\narea = \"closed\"\n");
+  expect_error(area_of_contact.text, area_of_contact.line + 1, "interaction[0].area",
+               {"applies to law = \"interface\" only"});
+  EXPECT_NO_THROW(
+      parse_scene_text(mutate(kBase, "Dt = 5.0\n", "Dt = 5.0\narea = \"closed\"\n").text, kLabel));
   const Mutation in2d =
       mutate(kBase, "Dt = 5.0\n",
              "Dt = 5.0\nnormal = \"radial\"\ncenter = [1.0, 1.0]\naxis = [0.0, 1.0]\n");

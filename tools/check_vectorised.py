@@ -30,7 +30,7 @@ RULES = [
     (r"^void mmpm::mm_detail::pass_a_lanes<", 30,
      # Coulomb friction in 3D: GCC 12 rejects its masked loads
      # (docs/multimaterial.md "Pass A in SIMD lanes").
-     r"\(mmpm::Law\)2, false, 3,",
+     r"\(mmpm::Law\)2, false, false, 3,",
      "multimaterial pass A lanes (kernels/mm_pair_batch.hpp)"),
     (r"^void mmpm::mm_detail::pass_b_lanes<", 16, None,
      "multimaterial pass B lanes (kernels/mm_pair_batch.hpp)"),

@@ -143,6 +143,7 @@ CASES = {
             "simulation.flip": ["1.0", "0.99", "0.9"],
             "simulation.precision": ['"double"', '"float"'],
             "grid.damping": ["10.0", "20.0", "40.0"],
+            "interaction[0].area": ['"paper"', '"closed"'],
         }),
     "dls": dict(
         scene="inputs/dls.toml", measure=dls_error, cell_levels=[1.0, 0.5],
@@ -153,6 +154,7 @@ CASES = {
             "simulation.flip": ["1.0", "0.99", "0.9"],
             "simulation.precision": ['"double"', '"float"'],
             "grid.damping": ["50.0", "100.0", "200.0"],
+            "interaction[0].area": ['"paper"', '"closed"'],
         }),
     "sphere": dict(
         scene="inputs/sphere_in_cube.toml", measure=sphere_error, cell_levels=[1.0],
@@ -160,6 +162,7 @@ CASES = {
             "simulation.cfl": ["0.3", "0.5"],
             "simulation.precision": ['"double"', '"float"'],
             "interaction[0].integration": ['"explicit"', '"exact"'],
+            "interaction[0].area": ['"paper"', '"closed"'],
         }),
     "incline": dict(
         scene="inputs/incline_block.toml", measure=incline_error, cell_levels=[1.0, 0.5],

@@ -243,6 +243,8 @@ void write_interaction(Writer& w, const InteractionSpec& in) {
   if (in.separation == Separation::position) w.num("contact_offset", in.contact_offset);
   w.boolean("force_limit", in.force_limit);
   w.word("integration", in.integration);
+  // Read only with the interface law (parse.cpp rejects it otherwise).
+  if (in.law == Law::interface) w.word("area", in.area);
 }
 
 std::string boundary_where_text(const Writer& w, const BoundarySpec& b) {

@@ -67,6 +67,8 @@ inline constexpr std::array<EnumName<Integration>, 2> kIntegrationNames{
     {{"explicit", Integration::explicit_}, {"exact", Integration::exact}}};
 inline constexpr std::array<EnumName<TractionLaw>, 2> kTractionLawNames{
     {{"linear", TractionLaw::linear}, {"bilinear", TractionLaw::bilinear}}};
+inline constexpr std::array<EnumName<ContactArea>, 2> kContactAreaNames{
+    {{"paper", ContactArea::paper}, {"closed", ContactArea::closed}}};
 inline constexpr std::array<EnumName<LoadKind>, 2> kLoadKindNames{
     {{"traction", LoadKind::traction}, {"gravity", LoadKind::gravity}}};
 inline constexpr std::array<EnumName<ParticleOrder>, 2> kParticleOrderNames{
@@ -105,6 +107,9 @@ constexpr std::span<const EnumName<Integration>> enum_names(Integration) {
 }
 constexpr std::span<const EnumName<TractionLaw>> enum_names(TractionLaw) {
   return kTractionLawNames;
+}
+constexpr std::span<const EnumName<ContactArea>> enum_names(ContactArea) {
+  return kContactAreaNames;
 }
 constexpr std::span<const EnumName<LoadKind>> enum_names(LoadKind) {
   return kLoadKindNames;

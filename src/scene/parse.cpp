@@ -1082,7 +1082,7 @@ class SceneReader {
   void add_interaction(const Table& t) {
     t.only({"materials", "law", "friction", "Dn", "Dt", "traction_law", "Dn_compression", "normal",
             "normal_vector", "center", "axis", "separation", "contact_offset", "min_volume",
-            "force_limit", "integration"});
+            "force_limit", "integration", "area"});
     InteractionSpec in;
     in.where = t.where();
     const Field mats = t.need("materials");
@@ -1135,6 +1135,11 @@ class SceneReader {
     }
     if (auto f = t.get("force_limit")) in.force_limit = f->boolean();
     if (auto f = t.get("integration")) in.integration = f->choice(kIntegrationNames);
+    if (auto f = t.get("area")) {
+      if (!interface)
+        f->fail("area applies to law = \"interface\" only (the contact area of P-20)");
+      in.area = f->choice(kContactAreaNames);
+    }
     scene_.interactions.push_back(std::move(in));
   }
 

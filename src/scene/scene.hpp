@@ -27,6 +27,9 @@ enum class NormalMethod { mvg, avg, specified, radial, rigid };
 enum class Separation { displacement, position, extrapolated };
 enum class Integration { explicit_, exact };
 enum class TractionLaw { linear, bilinear };  // bilinear: stiff in compression (ALGORITHM §3.2)
+// Nodal domains of the contact area (P-20): as they are (the paper), or with the
+// interface's opening closed first (docs/multimaterial.md §7.1).
+enum class ContactArea { paper, closed };
 enum class LoadKind { traction, gravity };
 enum class ParticleOrder { color, tile };  // storage order of the sorted particles
 
@@ -147,6 +150,7 @@ struct InteractionSpec {
   double contact_offset = 0.8;  // δ_con / h⊥, position separation only (P-14)
   bool force_limit = true;
   Integration integration = Integration::explicit_;
+  ContactArea area = ContactArea::paper;  // interface law only
   Where where;
 };
 

@@ -49,6 +49,7 @@ class MultimaterialStage {
       pp.omega_min = Real(it.min_volume * cell);
       pp.force_limit = it.force_limit;
       pp.integration = it.integration;
+      pp.closed_area = it.law == Law::interface && it.area == ContactArea::closed;
       if (it.law == Law::interface) has_interface_ = true;
       params_.push_back(pp);
     }
