@@ -14,7 +14,16 @@
 namespace mmpm {
 namespace {
 
-const char* kBase = R"(
+// The one material of every scene below.
+const std::string kMaterialA = R"([[material]]
+name = "a"
+type = "isotropic"
+density = 1.0
+E = 100.0
+nu = 0.3
+)";
+
+const std::string kBase = R"(
 [simulation]
 dimension = 2
 end_time = 1.0
@@ -23,13 +32,7 @@ origin = [-4.0, -4.0]
 cell = [0.5, 0.5]
 cells = [16, 16]
 shape = "linear"
-[[material]]
-name = "a"
-type = "isotropic"
-density = 1.0
-E = 100.0
-nu = 0.3
-)";
+)" + kMaterialA;
 
 std::pair<Vec3, Vec3> extent(const ParticleSeeds& s) {
   Vec3 lo{1e9, 1e9, 0}, hi{-1e9, -1e9, 0};
@@ -180,8 +183,7 @@ TEST(Bodies, ManyOverlapsMatchTheDefinition3D) {
   std::ostringstream t;
   t << "[simulation]\ndimension = 3\nend_time = 1.0\n[grid]\norigin = [-4.0, -4.0, -4.0]\n"
     << "cell = [0.5, 0.5, 0.5]\ncells = [16, 16, 16]\nshape = \"linear\"\n"
-    << "[[material]]\nname = \"a\"\ntype = \"isotropic\"\ndensity = 1.0\nE = 100.0\nnu = 0.3\n"
-    << "[[body]]\nmaterial = \"a\"\nshape = \"box\"\nmin = [-3.0, -3.0, -3.0]\n"
+    << kMaterialA << "[[body]]\nmaterial = \"a\"\nshape = \"box\"\nmin = [-3.0, -3.0, -3.0]\n"
     << "max = [3.0, 3.0, 3.0]\n";
   Lcg r{7}, tilt{11};  // tilt: the cylinders' axes, drawn apart so the other bodies stay put
   for (int b = 0; b < 15; ++b) {
@@ -221,13 +223,7 @@ origin = [-1.0, -1.0, -1.0]
 cell = [0.25, 0.25, 0.25]
 cells = [24, 24, 24]
 shape = "linear"
-[[material]]
-name = "a"
-type = "isotropic"
-density = 1.0
-E = 100.0
-nu = 0.3
-[[body]]
+)" + kMaterialA + R"([[body]]
 material = "a"
 shape = "cylinder"
 center = [0.5, 0.25, 0.25]
