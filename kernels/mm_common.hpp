@@ -115,6 +115,21 @@ struct MMStats {
 inline constexpr unsigned char kStickNormal = 1;
 inline constexpr unsigned char kStickTangential = 2;
 inline constexpr unsigned char kStickBoth = 4;
+// The normal direction is in the perfect compression branch of the bilinear law: a
+// one-sided constraint, as contact is (docs/multimaterial.md §4.1). It sticks only while
+// the pair approaches (Δp_a·n < 0): pass A decides it on its momenta, pass B again on the
+// updated ones. Before, the stick held a closed gap shut while the bodies pulled apart
+// (the bouncing bars of §4.1).
+inline constexpr unsigned char kOneSidedNormal = 8;
+
+// The stick flags with a one-sided normal decided by whether the pair approaches.
+inline unsigned char resolve_one_sided(unsigned char stick, bool approaching) {
+  if ((stick & kOneSidedNormal) == 0) return stick;
+  const bool tangential = (stick & (kStickTangential | kStickBoth)) != 0;
+  return (unsigned char)(kOneSidedNormal | (approaching ? kStickNormal : 0) |
+                         (tangential ? kStickTangential : 0) |
+                         (approaching && tangential ? kStickBoth : 0));
+}
 
 // Fields handled at one node (gathered into fixed-size local arrays).
 inline constexpr int kMaxFields = 32;

@@ -300,11 +300,17 @@ template <NormalMethod M, Law L, bool UseDf, bool Closed, int D, class Real>
       const Real pn = perfect_n ? one : none, pt = perfect_t ? one : none;
       const Real ln = (one - pn) * limiting * (over_n ? one : none);
       const Real lt = (one - pt) * limiting * (over_t ? one : none);
-      const Real sn = pn + ln, st = pt + lt;  // stick: perfect or limited (exclusive)
+      const Real st = pt + lt;  // stick: perfect or limited (exclusive)
+      // A perfect compression branch of the bilinear law is one-sided
+      // (kOneSidedNormal, docs/multimaterial.md §4.1): it sticks only while the
+      // pair approaches and, released, exerts no force.
+      const Real one_sided = pn * (bilinear & (dn < 0) ? one : none);
+      const Real released = one_sided * (dp_n < 0 ? none : one);
+      const Real sn = pn + ln - released;
       flags = sn * Real(kStickNormal) + st * Real(kStickTangential) + sn * st * Real(kStickBoth) +
-              Real(8) * (ln + lt);
+              one_sided * Real(kOneSidedNormal) + Real(16) * (ln + lt);
       change = stick_change_lane<D, Real>(sn != none, st != none, dp, n);
-      const Real on = sn != none ? Real(0) : fn, ot = st != none ? Real(0) : ft;
+      const Real on = sn != none ? Real(0) : fn, ot = st != none ? Real(0) : ft;  // perfect: fn = 0
       for (int d = 0; d < D; ++d) force[d] = on * n[d] + ot * t[d];
       energy = double(sn != none ? Real(0) : en * area) + double(st != none ? Real(0) : et * area);
     }
@@ -315,11 +321,11 @@ template <NormalMethod M, Law L, bool UseDf, bool Closed, int D, class Real>
       B.flags[i] = valid ? flags : Real(0);
     }
   }
-  if constexpr (L == Law::interface) {  // unpack the flags: stick bits + 8 × limited
+  if constexpr (L == Law::interface) {  // unpack the flags: stick bits + 16 × limited
     for (int i = 0; i < count; ++i) {
       const int code = int(B.flags[i]);
-      B.stick[i] = (unsigned char)(code & 7);
-      B.limited[i] = code >> 3;
+      B.stick[i] = (unsigned char)(code & 15);
+      B.limited[i] = code >> 4;
     }
   } else {  // contact laws: no force, energy or flags
     for (int i = 0; i < count; ++i) {
@@ -347,8 +353,15 @@ template <Law L, int D, class Real>
     VecD<D, Real> change;
     if constexpr (L == Law::interface) {
       const unsigned char s = B.stick[i];
-      change = stick_change_lane<D, Real>((s & (kStickNormal | kStickBoth)) != 0,
-                                          (s & (kStickTangential | kStickBoth)) != 0, dp, n);
+      // resolve_one_sided on the updated momenta, its flags as 0/1 Reals: with
+      // selects between booleans GCC 12 left the 3D float loop scalar (as in
+      // pass_a_lanes).
+      const Real stuck = (s & (kStickNormal | kStickBoth)) != 0 ? Real(1) : Real(0);
+      const Real one_sided = (s & kOneSidedNormal) != 0 ? Real(1) : Real(0);
+      const Real approaching = dot<D, Real>(dp, n) < 0 ? Real(1) : Real(0);
+      const Real normal = stuck + one_sided * (approaching - stuck);
+      const Real tangential = (s & (kStickTangential | kStickBoth)) != 0 ? Real(1) : Real(0);
+      change = stick_change_lane<D, Real>(normal != Real(0), tangential != Real(0), dp, n);
     } else {
       const bool contact = (dot<D, Real>(dp, n) < 0) & (B.dn[i] < 0);  // in_contact
       change = contact_change_lane<L, D, Real>(contact, friction, dp, n);

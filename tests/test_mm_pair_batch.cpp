@@ -136,6 +136,7 @@ void check_two_fields() {
   long cases = 0, limited = 0, screened_cases = 0;
   double energy = 0;
   long closed_area_changed = 0;
+  long one_sided_stuck = 0, one_sided_released = 0;  // pass A's decisions
   for (Law law : {Law::stick, Law::frictionless, Law::friction, Law::interface})
     for (NormalMethod normal : {NormalMethod::mvg, NormalMethod::avg, NormalMethod::specified,
                                 NormalMethod::radial, NormalMethod::rigid})
@@ -151,7 +152,9 @@ void check_two_fields() {
         pp.omega_min = variant & 2 ? Real(0.4) : Real(0);  // screens some nodes
         pp.force_limit = (variant & 4) == 0;
         pp.traction_law = variant & 8 ? TractionLaw::bilinear : TractionLaw::linear;
-        pp.Dn_compression = Real(7e3);
+        // A perfect compression branch (one-sided, docs/multimaterial.md §4.1) in half
+        // of the bilinear cases.
+        pp.Dn_compression = variant & 2 ? kInf : Real(7e3);
         pp.closed_area = (variant & 32) != 0;  // the area of docs/multimaterial.md §7.1
         const auto& k = stiffness[std::size_t((variant >> 3) % 4)];
         pp.Dn = k[0];
@@ -171,13 +174,16 @@ void check_two_fields() {
           s1.cfg.use_force_difference = s2.cfg.use_force_difference = with_df;
           const Outcome o1 = run(batched, s1, true);
           const Outcome o2 = run(per_node, s2, false);
-          double stiffest = double(pp.Dn_compression);
+          double stiffest = std::isinf(pp.Dn_compression) ? 0.0 : double(pp.Dn_compression);
           for (Real x : k) stiffest = std::isinf(x) ? stiffest : std::max(stiffest, double(x));
           expect_same("law " + std::to_string(int(law)) + " normal " + std::to_string(int(normal)) +
                           " variant " + std::to_string(variant) + " df " + std::to_string(with_df),
                       batched, o1, per_node, o2, force_tolerance<Real>(stiffest));
           ++cases;
           limited += o2.limited_total;
+          for (unsigned char f : o2.flags)
+            if (f & mmpm::kOneSidedNormal)
+              ++((f & mmpm::kStickNormal) ? one_sided_stuck : one_sided_released);
           energy += o2.stats.interface_energy;
           if (pp.closed_area) {  // the same nodes with the paper's area
             PairParams<Real> paper = pp;
@@ -197,6 +203,8 @@ void check_two_fields() {
   EXPECT_GT(limited, 0) << "no direction hit the force limit";
   EXPECT_GT(energy, 0.0);
   EXPECT_GT(closed_area_changed, 0) << "the closed area changed nothing";
+  EXPECT_GT(one_sided_stuck, 0) << "no perfect compression branch stuck";
+  EXPECT_GT(one_sided_released, 0) << "no perfect compression branch was released";
   EXPECT_GT(screened_cases, 0);
 }
 
