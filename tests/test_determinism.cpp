@@ -282,6 +282,19 @@ TEST(Determinism, ImperfectInterfaceClosedArea2D) {
   EXPECT_GT(r.energies.interface, 0.0);
 }
 
+// The bilinear law's perfect compression branch, one-sided (docs/multimaterial.md
+// §4.1): the blocks pushed into each other, so nodes stick, part and stick again,
+// each decided in pass A and again in pass B.
+TEST(Determinism, ImperfectInterfaceBilinearPerfectCompression2D) {
+  BoxScene2D s =
+      two_materials("double", std::string(kNumericInterface) + "traction_law = \"bilinear\"\n");
+  s.scheme = "MUSL";
+  s.b0_vel[0] = 30.0;
+  s.b1_vel[0] = -30.0;
+  const RunResult r = check_scene(s.text(), "2D gimp double", 40.0);
+  EXPECT_GT(r.counters.multimaterial_nodes, 0);
+}
+
 TEST(Determinism, ImperfectInterfaceFloat2D) {
   const RunResult r =
       check_scene(two_materials("float", kNumericInterface).text(), "2D gimp float", 40.0);
