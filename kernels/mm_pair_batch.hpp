@@ -310,7 +310,8 @@ template <NormalMethod M, Law L, bool UseDf, bool Closed, int D, class Real>
       flags = sn * Real(kStickNormal) + st * Real(kStickTangential) + sn * st * Real(kStickBoth) +
               one_sided * Real(kOneSidedNormal) + Real(16) * (ln + lt);
       change = stick_change_lane<D, Real>(sn != none, st != none, dp, n);
-      const Real on = sn != none ? Real(0) : fn, ot = st != none ? Real(0) : ft;  // perfect: fn = 0
+      const Real on = sn != none ? Real(0) : fn,
+                 ot = st != none ? Real(0) : ft;  // released: perfect, fn = 0
       for (int d = 0; d < D; ++d) force[d] = on * n[d] + ot * t[d];
       energy = double(sn != none ? Real(0) : en * area) + double(st != none ? Real(0) : et * area);
     }
