@@ -283,8 +283,7 @@ TEST(Determinism, ImperfectInterfaceClosedArea2D) {
 }
 
 // The bilinear law's perfect compression branch, one-sided (docs/multimaterial.md
-// §4.1): the blocks pushed into each other, so nodes stick, part and stick again,
-// each decided in pass A and again in pass B.
+// §4.1), decided in pass A and again in pass B: the blocks pushed into each other.
 TEST(Determinism, ImperfectInterfaceBilinearPerfectCompression2D) {
   BoxScene2D s =
       two_materials("double", std::string(kNumericInterface) + "traction_law = \"bilinear\"\n");
