@@ -393,19 +393,19 @@ InteractionResult<D, Real> interact_pass_a(const MaterialSide<D, Real>& a,
   if (use_force_difference) df = force_difference<D, Real>(a.m, a.f, b.m, b.f, b_is_rigid);
 
   const Real dp_n = dot<D, Real>(G.dp, G.n);
-  DirectionOutcome<Real> on =
+  const DirectionOutcome<Real> on =
       interface_direction(pp, tr.perfect_n, tr.stiffness_n, tr.normal, tr.energy_n, area, m_red, dt,
                           limit_dt, dn, dp_n, dot<D, Real>(df, G.n));
   const DirectionOutcome<Real> ot =
       interface_direction(pp, tr.perfect_t, tr.stiffness_t, tr.tangential, tr.energy_t, area, m_red,
                           dt, limit_dt, G.delta_t, dot<D, Real>(G.dp, G.t), dot<D, Real>(df, G.t));
-  // A perfect compression branch is one-sided (kOneSidedNormal): released while the pair
-  // separates, with no force and no energy, as contact is (docs/multimaterial.md §4.1).
-  const bool one_sided = pp.traction_law == TractionLaw::bilinear && dn < 0 && tr.perfect_n;
-  if (one_sided && !(dp_n < 0)) on = DirectionOutcome<Real>{};
   r.stick = (on.stick ? kStickNormal : 0) | (ot.stick ? kStickTangential : 0);
   if (on.stick && ot.stick) r.stick |= kStickBoth;
-  if (one_sided) r.stick |= kOneSidedNormal;
+  // A perfect compression branch is one-sided (kOneSidedNormal): released while the pair
+  // separates, as contact is (docs/multimaterial.md §4.1); perfect, it has no force or
+  // energy to drop. Pass B resolves the flag the same way on its momenta.
+  if (pp.traction_law == TractionLaw::bilinear && dn < 0 && tr.perfect_n)
+    r.stick = resolve_one_sided(r.stick | kOneSidedNormal, dp_n < 0);
   r.limited = int(on.limited) + int(ot.limited);
   r.momentum_change = directional_stick_change<D, Real>(r.stick, G.dp, G.n);
   for (int d = 0; d < D; ++d) r.force[d] = on.force * G.n[d] + ot.force * G.t[d];
