@@ -60,7 +60,8 @@ int main(int argc, char** argv) {
   bool quiet = false, force = false;
   run->add_option("scene", scene_file, "scene file (TOML)");
   run->add_option("--restart", restart_dir, "continue the run in DIR from its last checkpoint");
-  run->add_option("--out", out_dir, "output directory (default results/<scene name>)");
+  auto* out_option =
+      run->add_option("--out", out_dir, "output directory (default results/<scene name>)");
   run->add_option("--threads", threads, "OpenMP threads")->check(kCount);
   run->add_option("--set", sets, "override a scene key: KEY=VALUE (TOML value)");
   run->add_flag("--quiet", quiet, "no progress line, no timing table");
@@ -91,8 +92,22 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : 2;
+    // --help prints the help; an error gets one line, as bad scene input does
+    // (CLI11's own report adds a second line).
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::cerr << "mmpm: " << e.what() << " (mmpm --help, mmpm COMMAND --help)\n";
+    return 2;
+  }
+  if (out_option->count() > 0 && out_dir.empty()) {
+    std::cerr << "mmpm run: --out: expected a directory, got an empty name\n";
+    return 2;
+  }
+  // A restart continues the scene stored with the run (DIR/scene.toml) in
+  // DIR; a scene file, --set or --out given with it would be ignored.
+  if (!restart_dir.empty() && (!scene_file.empty() || !sets.empty() || out_option->count() > 0)) {
+    std::cerr << "mmpm run: --restart DIR continues the scene stored in DIR (DIR/scene.toml) and "
+                 "writes to DIR; expected no scene file, --set or --out with it\n";
+    return 2;
   }
 
   try {

@@ -411,8 +411,6 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
     add_series_row(*sim, st, sim_stages(), dim, *final_energies);
   snapshot_if_due(true);
   writer->write_series(st.names, st.columns);
-  writer->finish();
-  fs::remove(dir / "checkpoint.bin");
 
   const double wall = wall_so_far();
   auto stages = sim_stages();
@@ -451,7 +449,17 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
   j["nodes_3plus"] = c.nodes_3plus;
   j["force_limited_nodes"] = c.force_limited_nodes;
   j["stopped_by"] = stopped_by;
-  io::write_summary(dir / "summary.json", j);
+  // summary.json is written before run.h5 gets its name, and removed again
+  // if that fails: a run either leaves both, or neither and its partial
+  // and checkpoint for a restart (a full disk, 2026-11-29).
+  try {
+    writer->finish([&] { io::write_summary(dir / "summary.json", j); });
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove(dir / "summary.json", ignored);
+    throw;
+  }
+  fs::remove(dir / "checkpoint.bin");
   out.summary = j;
   if (opt.timing_table && !opt.quiet)
     print_timing_table(log, stages, calls, wall, sim->step_count(), sim->particle_count());

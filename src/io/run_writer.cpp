@@ -475,7 +475,7 @@ void RunWriter::write_series(const std::vector<std::string>& names,
   file_->flush();
 }
 
-void RunWriter::finish() {
+void RunWriter::finish(const std::function<void()>& before_publishing) {
   require_open("finish");
   std::string document, grid_document;
   {
@@ -489,10 +489,21 @@ void RunWriter::finish() {
   file_->close();
   // The data must be on disk before the name that promises a complete result.
   fsync_file(partial_path());
-  fs::rename(partial_path(), h5_path());
+  // Everything else first: if a write fails (a full disk), run.h5 does not
+  // appear, the partial stays and the run can be restarted from its
+  // checkpoint once there is room.
+  try {
+    write_file_atomic(xdmf_path(), document);
+    if (!grid_document.empty()) write_file_atomic(grid_xdmf_path(), grid_document);
+    if (before_publishing) before_publishing();
+    fs::rename(partial_path(), h5_path());
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove(xdmf_path(), ignored);
+    fs::remove(grid_xdmf_path(), ignored);
+    throw;
+  }
   fsync_directory(dir_);
-  write_file_atomic(xdmf_path(), document);
-  if (!grid_document.empty()) write_file_atomic(grid_xdmf_path(), grid_document);
 }
 
 void RunWriter::abandon() {

@@ -27,6 +27,7 @@
 #include <array>
 #include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -101,10 +102,12 @@ class RunWriter {
   void write_series(const std::vector<std::string>& names,
                     const std::vector<std::vector<double>>& columns);
 
-  // Closes the file, renames run.h5.partial to run.h5 (atomically, synced to
-  // disk), then writes run.xdmf describing every snapshot in the file (and
-  // run_grid.xdmf for the grid snapshots, if any).
-  void finish();
+  // Closes the file, writes run.xdmf describing every snapshot in the file
+  // (and run_grid.xdmf for the grid snapshots, if any), calls
+  // `before_publishing` (the driver's summary.json), then renames
+  // run.h5.partial to run.h5 (atomically, synced to disk). If any of these
+  // throws, the xdmf files are removed and the partial stays.
+  void finish(const std::function<void()>& before_publishing = {});
 
   // Closes and deletes the partial file: a failed run leaves nothing that
   // looks like a result. Does nothing after finish().

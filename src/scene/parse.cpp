@@ -220,6 +220,19 @@ class Field {
     if (!(x > 0)) fail("expected a number > 0, got " + format_number(x));
     return x;
   }
+  // A material constant or the thickness: they multiply each other and the
+  // lengths into masses, moduli and energies, which must stay normal numbers
+  // in float as well as in double (FLT_MAX ~3.4e38, FLT_MIN ~1.2e-38). In
+  // the scene's units (mm, ms, g, MPa) physical values lie far inside.
+  double modulus_like() const {
+    const double x = positive();
+    if (x < 1e-30 || x > 1e30)
+      fail(
+          "expected a number from 1e-30 to 1e30 (the products of such constants must stay "
+          "representable), got " +
+          format_number(x));
+    return x;
+  }
   double non_negative() const {
     const double x = number();
     if (x < 0) fail("expected a number >= 0, got " + format_number(x));
@@ -242,7 +255,14 @@ class Field {
   }
   std::string string() const {
     if (!v_->is_string()) wrong_type("a string");
-    return v_->as_string().str;
+    std::string s = v_->as_string().str;
+    // Names become directory names, series columns and messages; a control
+    // character (a NUL cut the directory name short) has no use in any of them.
+    for (const char c : s)
+      if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
+        fail("expected a string without control characters, got one with character code " +
+             std::to_string(int(static_cast<unsigned char>(c))));
+    return s;
   }
   std::string name() const {
     std::string s = string();
@@ -530,8 +550,14 @@ Keys axis_names(int dim) {
 }
 
 Vec3 normalized(const Field& f, Vec3 v) {
+  // Components near the double range's ends are scaled by the largest one
+  // first, so that the squares neither overflow nor underflow (ordinary
+  // vectors keep the plain division, and their bits).
+  const double big = std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])});
+  if (!(big > 0)) f.fail("expected a non-zero direction");
+  if (big > 1e150 || big < 1e-150)
+    for (double& c : v) c /= big;
   const double len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
-  if (!(len > 0)) f.fail("expected a non-zero direction");
   // Leave (nearly) unit vectors alone so a resolved scene reads back bit for bit.
   if (std::abs(len - 1.0) > 1e-14) {
     for (double& c : v) c /= len;
@@ -646,7 +672,7 @@ class SceneReader {
       }
     }
     if (auto f = t.get("plane")) sim.plane = f->choice(kPlaneNames);
-    if (auto f = t.get("thickness")) sim.thickness = f->positive();
+    if (auto f = t.get("thickness")) sim.thickness = f->modulus_like();
     sim.end_time = t.need("end_time").positive();
     sim.step_where = Where{src_.label(), 0, "simulation.cfl"};
     if (auto f = t.get("cfl")) {
@@ -706,23 +732,45 @@ class SceneReader {
     check_grid_memory(t.need("cells"));
     if (auto f = t.get("shape")) g.shape = f->choice(kShapeKindNames);
     if (auto f = t.get("damping")) g.damping = f->non_negative();
-    if (auto f = t.get("tile")) g.tile = f->int_at_least(0);
+    if (auto f = t.get("tile")) {
+      // The edge is rounded up to a power of two and a tile's cells are
+      // counted in 32-bit keys (kernels/binning.hpp); per-tile buffers grow
+      // with the edge^dim cells. 1024 (2D) and 128 (3D) are 32-64 times the
+      // defaults and hold 2^20-2^21 cells per tile.
+      const int most = dim() == 2 ? 1024 : 128;
+      g.tile = f->int_at_least(0);
+      if (g.tile > most)
+        f->fail("expected an integer from 0 (automatic) to " + std::to_string(most) +
+                " (cells per tile edge), got " + std::to_string(g.tile));
+    }
   }
 
   // Sizes a run could never allocate are bad input, said before anything
   // is allocated: a grid of 10^8 x 10^8 cells ended in std::bad_alloc
   // (exit 3), and a body with 10^5 particles per cell and direction in a
-  // seeding loop that did not end. The counts are lower bounds of what the
-  // solver stores (the grid's m, p, f, vel, dvel of one field; a particle's
-  // position, velocity, start, mass, volume and stress), so a run refused
-  // here could not have run.
+  // seeding loop that did not end. The bytes per node and per particle are
+  // a little below the peak that `mmpm check` measured (its resident memory
+  // at two particle counts, 2026-11-29: 2D 310 B per particle in double,
+  // 242 in float, 124 per node and material field in double; 3D 338, 273
+  // and 176), one field counted, so a run refused here could not have run.
+  // They were the arrays' bare sizes before (12 or 17 reals per particle),
+  // which let a scene of 24 GB pass and be killed by the kernel.
   double real_bytes() const {
     return scene_.simulation.precision == Precision::float64 ? 8.0 : 4.0;
+  }
+  double grid_bytes() const {
+    double nodes = 1;
+    for (int k = 0; k < dim(); ++k) nodes *= double(scene_.grid.cells[std::size_t(k)]) + 1;
+    return nodes * (dim() == 2 ? 15 : 21) * real_bytes();
+  }
+  double particle_bytes() const {
+    const bool dbl = scene_.simulation.precision == Precision::float64;
+    return dim() == 2 ? (dbl ? 300 : 230) : (dbl ? 330 : 265);
   }
   void check_grid_memory(const Field& f) const {
     double nodes = 1;
     for (int k = 0; k < dim(); ++k) nodes *= double(scene_.grid.cells[std::size_t(k)]) + 1;
-    const double need = nodes * (1 + 4 * dim()) * real_bytes(), have = physical_memory();
+    const double need = grid_bytes(), have = physical_memory();
     if (have > 0 && need > have)
       f.fail("the grid has " + number_text(nodes) + " nodes, at least " + gib_text(need) +
              " for its arrays, more than this machine's memory (" + gib_text(have) +
@@ -733,14 +781,15 @@ class SceneReader {
     for (int k = 0; k < dim(); ++k) cell *= scene_.grid.cell[std::size_t(k)];
     particles_estimate_ +=
         body_measure(b, dim(), clipped) / cell * std::pow(double(b.particles_per_cell), dim());
-    const double per_particle = (dim() == 2 ? 12 : 17) * real_bytes();
-    const double need = particles_estimate_ * per_particle, have = physical_memory();
+    const double need = particles_estimate_ * particle_bytes() + grid_bytes(),
+                 have = physical_memory();
     if (have > 0 && need > have) {
       const auto f = t.get("particles_per_cell");
-      const std::string why =
-          "the bodies up to this one hold about " + number_text(particles_estimate_) +
-          " particles, at least " + gib_text(need) + ", more than this machine's memory (" +
-          gib_text(have) + "); expected fewer particles per cell or smaller bodies";
+      const std::string why = "the bodies up to this one hold about " +
+                              number_text(particles_estimate_) +
+                              " particles, with the grid at least " + gib_text(need) +
+                              ", more than this machine's memory (" + gib_text(have) +
+                              "); expected fewer particles per cell or smaller bodies";
       if (f) f->fail(why);
       t.need("shape").fail(why);
     }
@@ -811,7 +860,7 @@ class SceneReader {
       name.fail("duplicate material name " + quote(m.name) + " (first defined at line " +
                 std::to_string(other->where.line) + ")");
     }
-    m.density = t.need("density").positive();
+    m.density = t.need("density").modulus_like();
     const std::string why = a_quoted(scene_name(m.type)) + " material needs it";
     switch (m.type) {
       case MaterialType::isotropic:
@@ -830,7 +879,7 @@ class SceneReader {
   }
 
   static void read_isotropic(const Table& t, MaterialSpec& m, const std::string& why) {
-    m.E = t.need("E", why).positive();
+    m.E = t.need("E", why).modulus_like();
     const Field nu = t.need("nu", why);
     m.nu = nu.number();
     // nu -> 0.5 makes the bulk modulus infinite; nu <= -1 makes it negative.
@@ -840,9 +889,9 @@ class SceneReader {
   }
 
   void read_transverse(const Table& t, MaterialSpec& m, const std::string& why) const {
-    m.EA = t.need("EA", why).positive();
-    m.ET = t.need("ET", why).positive();
-    m.GA = t.need("GA", why).positive();
+    m.EA = t.need("EA", why).modulus_like();
+    m.ET = t.need("ET", why).modulus_like();
+    m.GA = t.need("GA", why).modulus_like();
     const Field nuA = t.need("nuA", why);
     const Field nuT = t.need("nuT", why);
     m.nuA = nuA.number();
@@ -1240,7 +1289,16 @@ class SceneReader {
             .fail("a non-zero displacement needs ramp > 0 (the time to reach it)");
       }
     }
+    // Each boundary reports its reaction in series columns named after its
+    // label; a second boundary on the same face (another component fixed)
+    // gets "_2", "_3", ... so the columns stay distinct.
+    const std::string label = bc.label;
+    for (int k = 2; labelled(bc.label); ++k) bc.label = label + "_" + std::to_string(k);
     scene_.boundaries.push_back(std::move(bc));
+  }
+  bool labelled(const std::string& label) const {
+    return std::any_of(scene_.boundaries.begin(), scene_.boundaries.end(),
+                       [&](const BoundarySpec& b) { return b.label == label; });
   }
 
   void read_boundary_where(const Field& f, BoundarySpec& bc, std::size_t index) const {
@@ -1477,9 +1535,50 @@ std::vector<PathStep> parse_override_path(const std::string& key) {
   return steps;
 }
 
+// toml11 parses nested arrays and inline tables by recursion: 20 000 levels
+// overflowed the stack (a crash, not a message). No scene nests deeper than
+// a few levels, so deeper input is refused before toml11 sees it. Returns
+// the line where the nesting first passes kDeepestNesting, or 0. Strings
+// and comments are skipped; malformed ones are left to toml11's message.
+constexpr int kDeepestNesting = 64;
+int line_nested_too_deep(const std::string& text) {
+  int depth = 0, line = 1;
+  const std::size_t n = text.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const char c = text[i];
+    if (c == '\n') {
+      ++line;
+    } else if (c == '#') {
+      while (i + 1 < n && text[i + 1] != '\n') ++i;
+    } else if (c == '"' || c == '\'') {
+      const std::string triple(3, c);
+      const bool multiline = text.compare(i, 3, triple) == 0;
+      i += multiline ? 3 : 1;
+      while (i < n && (multiline ? text.compare(i, 3, triple) != 0 : text[i] != c)) {
+        if (text[i] == '\n') {
+          if (!multiline) break;
+          ++line;
+        }
+        if (c == '"' && text[i] == '\\' && i + 1 < n && text[i + 1] != '\n') ++i;
+        ++i;
+      }
+      if (multiline) i += 2;
+      if (i < n && text[i] == '\n') ++line;
+    } else if (c == '[' || c == '{') {
+      if (++depth > kDeepestNesting) return line;
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    }
+  }
+  return 0;
+}
+const std::string kNestingLimit =
+    "arrays and inline tables nested at most " + std::to_string(kDeepestNesting) + " levels deep";
+
 // Parses VALUE as the right-hand side of a TOML key; the value remembers
 // "--set KEY" as its file, which is how later messages blame the override.
 toml::value parse_override_value(const std::string& key, const std::string& text) {
+  if (line_nested_too_deep(text) != 0) override_fail(key, "expected a value with " + kNestingLimit);
   std::istringstream in("v = " + text);
   toml::value doc;
   try {
@@ -1561,6 +1660,8 @@ void apply_override(toml::value& root, const std::string& spec) {
 }
 
 toml::value parse_toml(const std::string& text, const std::string& label) {
+  if (const int line = line_nested_too_deep(text))
+    throw InputError(located(label, line, "", "TOML nesting too deep: expected " + kNestingLimit));
   std::istringstream in(text);
   try {
     return toml::parse(in, label);
