@@ -102,6 +102,22 @@ TEST(Cli, CommandLineErrorsAreOneLine) {
   }
 }
 
+// A checkpoint.bin that is a directory failed in the read with
+// "basic_filebuf::underflow error reading the file", naming no file.
+TEST(Cli, RestartFromADirectoryNamedCheckpointNamesIt) {
+  TempDir tmp;
+  const fs::path out = tmp / "o";
+  ASSERT_EQ(run_mmpm({"run", bar_scene(), "--out", out.string(), "--quiet", "--set",
+                      "simulation.end_time=0.01"})
+                .exit_code,
+            0);
+  fs::create_directory(out / "checkpoint.bin");
+  const CmdResult r = run_mmpm({"run", "--restart", out.string(), "--quiet"});
+  EXPECT_EQ(r.exit_code, 2) << r.describe();
+  ASSERT_EQ(lines_of(r.err).size(), 1u) << r.describe();
+  EXPECT_TRUE(contains(r.err, (out / "checkpoint.bin").string())) << r.err;
+}
+
 // A scene nested 20 000 levels deep overflowed toml11's recursive parser
 // (SIGSEGV); nesting is now refused past 64 levels, in the file and in --set.
 TEST(Cli, DeepNestingIsBadInputNotACrash) {
@@ -406,6 +422,18 @@ TEST(Cli, AbsurdModulusIsBadInputNotAHang) {
       expect_no_result(out);
     }
   }
+}
+
+// Grid damping sets the step too (dt < 2 / damping): a damping of 1e308
+// was reported as "the fastest speed, the wave speed of material 'steel'".
+TEST(Cli, AbsurdDampingIsNamedAsWhatSetsTheStep) {
+  const CmdResult r = run_mmpm({"check", bar_scene(), "--set", "grid.damping=1e308"});
+  EXPECT_EQ(r.exit_code, 2) << r.describe();
+  const auto lines = lines_of(r.err);
+  ASSERT_EQ(lines.size(), 1u) << r.describe();
+  EXPECT_TRUE(contains(lines[0], "the step follows grid.damping")) << lines[0];
+  EXPECT_FALSE(contains(lines[0], "wave speed")) << lines[0];
+  EXPECT_TRUE(r.out.empty()) << "the resolved scene is printed only for good input\n" << r.out;
 }
 
 // A body's velocity sets the step as well (dt = cfl h / (c + |v|)); when

@@ -19,9 +19,9 @@ int check_scene(const std::string& file, const std::vector<std::string>& sets) {
   using namespace mmpm;
   Scene scene = parse_scene_file(file, sets);
   auto sim = make_simulation(scene);  // builds particles: catches geometry errors
-  std::cout << format_scene(scene);
   const double crit = critical_time_step(scene), dt = sim->dt();
-  check_step_count(scene, dt);
+  check_step_count(scene, dt);  // before printing: bad input leaves stdout empty
+  std::cout << format_scene(scene);
   std::cout << "# instantiation: " << sim->instantiation() << "\n"
             << "# particles: " << sim->particle_count() << ", nodes: " << sim->node_count()
             << ", material fields: " << sim->field_count() << ", tile: " << sim->tile_edge()

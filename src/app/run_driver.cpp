@@ -484,6 +484,10 @@ RunOutcome restart_run(const fs::path& dir, const RunOptions& options, std::ostr
     throw InputError(scene_file.string() + ": no resolved scene to restart from");
   const fs::path ckpt = dir / "checkpoint.bin";
   if (!fs::exists(ckpt)) throw InputError(ckpt.string() + ": no checkpoint to restart from");
+  // A directory opens as a stream and fails only in the read, whose message
+  // ("basic_filebuf::underflow ...") names no file.
+  if (!fs::is_regular_file(ckpt))
+    throw InputError(ckpt.string() + ": expected a checkpoint file, found another kind of entry");
   Scene scene = parse_scene_file(scene_file.string());
   std::vector<io::Blob> blobs;
   try {

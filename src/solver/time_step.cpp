@@ -193,7 +193,13 @@ constexpr double kMaxSteps = 1e12;
     msg << ", so end_time / dt = " << steps << " steps; expected at most " << kMaxSteps;
   else
     msg << "; expected a positive time step";
-  if (!fastest.who.empty())
+  const double hmin = smallest_cell(scene), speed = wave.speed + motion.speed;
+  const bool damping_sets_it =
+      damping_time_step(scene) < (speed > 0 ? hmin / speed : scene.simulation.end_time);
+  if (damping_sets_it)
+    msg << " (the step follows grid.damping = " << scene.grid.damping
+        << ": explicit damping needs dt < 2 / damping; check grid.damping)";
+  else if (!fastest.who.empty())
     msg << " (the step follows the fastest speed, " << fastest.who << ", " << fastest.speed
         << "; check "
         << (&fastest == &motion ? "that velocity" : "that material's modulus and density") << ")";
