@@ -758,21 +758,20 @@ class SceneReader {
   double real_bytes() const {
     return scene_.simulation.precision == Precision::float64 ? 8.0 : 4.0;
   }
-  double grid_bytes() const {
+  double grid_nodes() const {
     double nodes = 1;
     for (int k = 0; k < dim(); ++k) nodes *= double(scene_.grid.cells[std::size_t(k)]) + 1;
-    return nodes * (dim() == 2 ? 15 : 21) * real_bytes();
+    return nodes;
   }
+  double grid_bytes() const { return grid_nodes() * (dim() == 2 ? 15 : 21) * real_bytes(); }
   double particle_bytes() const {
     const bool dbl = scene_.simulation.precision == Precision::float64;
     return dim() == 2 ? (dbl ? 300 : 230) : (dbl ? 330 : 265);
   }
   void check_grid_memory(const Field& f) const {
-    double nodes = 1;
-    for (int k = 0; k < dim(); ++k) nodes *= double(scene_.grid.cells[std::size_t(k)]) + 1;
     const double need = grid_bytes(), have = physical_memory();
     if (have > 0 && need > have)
-      f.fail("the grid has " + number_text(nodes) + " nodes, at least " + gib_text(need) +
+      f.fail("the grid has " + number_text(grid_nodes()) + " nodes, at least " + gib_text(need) +
              " for its arrays, more than this machine's memory (" + gib_text(have) +
              "); expected fewer or larger cells");
   }

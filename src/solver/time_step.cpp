@@ -56,16 +56,20 @@ double smallest_cell(const Scene& scene) {
   return h;
 }
 
+// The time the fastest wave (plus the fastest body) needs to cross the
+// smallest cell; end_time when nothing moves or carries waves.
+double wave_time_step(const Scene& scene) {
+  const double speed = fastest_wave(scene).speed + fastest_motion(scene).speed;
+  return speed > 0 ? smallest_cell(scene) / speed : scene.simulation.end_time;
+}
+
 }  // namespace
 
 // ALGORITHM §2: explicit integration is stable for dt below the time a
 // dilatational wave needs to cross the smallest cell (moving bodies add
 // their speed), and below 2 / grid.damping (damping_time_step).
 double critical_time_step(const Scene& scene) {
-  const double hmin = smallest_cell(scene);
-  const double speed = fastest_wave(scene).speed + fastest_motion(scene).speed;
-  const double wave = speed > 0 ? hmin / speed : scene.simulation.end_time;
-  return std::min(wave, damping_time_step(scene));
+  return std::min(wave_time_step(scene), damping_time_step(scene));
 }
 
 double fastest_wave_speed(const Scene& scene) {
@@ -193,10 +197,7 @@ constexpr double kMaxSteps = 1e12;
     msg << ", so end_time / dt = " << steps << " steps; expected at most " << kMaxSteps;
   else
     msg << "; expected a positive time step";
-  const double hmin = smallest_cell(scene), speed = wave.speed + motion.speed;
-  const bool damping_sets_it =
-      damping_time_step(scene) < (speed > 0 ? hmin / speed : scene.simulation.end_time);
-  if (damping_sets_it)
+  if (damping_time_step(scene) < wave_time_step(scene))
     msg << " (the step follows grid.damping = " << scene.grid.damping
         << ": explicit damping needs dt < 2 / damping; check grid.damping)";
   else if (!fastest.who.empty())
