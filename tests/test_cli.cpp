@@ -191,6 +191,13 @@ const BadInput kBadInputs[] = {
     {"E_subnormal", "E ", "E       = 1e-308", "material[0].E", "1e-308"},
     {"thickness_huge", "thickness ", "thickness = 1e308", "simulation.thickness", "1e308"},
     {"control_character", "name     = ", "name     = \"b\\u0000ar\"", "body[0].name", "u0000"},
+    // Found by the same run: rotate = 1e308 lost the angle in the conversion
+    // to radians and was blamed on 'grid' with no line; a cell count past 64
+    // bits was reported as 9223372036854775807, as if the file said so.
+    {"rotate_huge", "material = ", "material = \"steel\"\nrotate   = 1e308", "body[0].rotate",
+     "rotate   = 1e308"},
+    {"cells_beyond_64_bits", "cells  = ", "cells  = [99999999999999999999, 6]", "grid.cells",
+     "99999999999999999999"},
 };
 
 class CliBadInput : public ::testing::TestWithParam<BadInput> {};

@@ -16,6 +16,7 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstring>
 #include <map>
@@ -312,6 +313,29 @@ void check_killed_run_continues_bitwise(const std::string& scene_text) {
     EXPECT_FALSE(fs::exists(dir / "summary.json"));
     mmpm::io::write_checkpoint(dir / "checkpoint.bin", blobs);
   }
+
+  // 2c. A scene.toml edited since the checkpoint (another E) is refused: the
+  // checkpointed state would continue under other physics. Exit 2, the
+  // message names the file and the edited line, and the checkpoint stays.
+  const std::string resolved = read_text(dir / "scene.toml");
+  {
+    const std::size_t e_line = resolved.find("\nE = ");
+    ASSERT_NE(e_line, std::string::npos) << resolved;
+    std::string edited = resolved;
+    edited.replace(e_line, resolved.find('\n', e_line + 1) - e_line, "\nE = 1234.5");
+    write_text(dir / "scene.toml", edited);
+    const CmdResult refused =
+        run_mmpm({"run", "--restart", dir.string(), "--threads", "1", "--quiet"});
+    EXPECT_EQ(refused.exit_code, 2) << refused.describe();
+    EXPECT_TRUE(contains(refused.err, (dir / "scene.toml").string())) << refused.err;
+    EXPECT_TRUE(contains(refused.err, "key 'material[0].E'")) << refused.err;
+    EXPECT_TRUE(contains(refused.err, "`E = 1234.5`")) << refused.err;
+    EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
+    EXPECT_TRUE(fs::exists(dir / "checkpoint.bin"));
+    EXPECT_FALSE(fs::exists(dir / "summary.json"));
+  }
+  // A comment and blank lines change no value: the restart goes on.
+  write_text(dir / "scene.toml", "# restarted by the test\n\n" + resolved);
 
   // 3. Restart and compare.
   const CmdResult again = run_mmpm({"run", "--restart", dir.string(), "--threads", "1", "--quiet"});

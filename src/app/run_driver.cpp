@@ -3,15 +3,18 @@
 #include <omp.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <optional>
 #include <ostream>
 #include <sstream>
+#include <string_view>
 
 #include "app/build_info.hpp"
 #include "app/energy_guard.hpp"
@@ -129,6 +132,65 @@ std::vector<io::Blob> driver_blobs(const DriverState& st, double wall_s,
   for (std::size_t k = 0; k < st.columns.size(); ++k)
     b.push_back(io::make_blob("driver.series." + std::to_string(k), st.columns[k]));
   return b;
+}
+
+// The resolved scene the checkpointed run ran, kept with its state: a
+// scene.toml edited since (another E, other cells) would continue that state
+// under other physics and give a result that neither scene produces.
+constexpr std::string_view kSceneBlob = "driver.scene";
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+// The dotted key ("material[1].E") that line k of a resolved scene sets, or
+// "" for a section header: format_scene() writes one `key = value` per line
+// under `[section]` and `[[array]]` headers.
+std::string resolved_key(const std::vector<std::string>& lines, std::size_t k) {
+  std::map<std::string, int> seen;
+  std::string section;
+  for (std::size_t i = 0; i <= k && i < lines.size(); ++i) {
+    const std::string& line = lines[i];
+    if (line.rfind("[[", 0) == 0) {
+      const std::string name = line.substr(2, line.find("]]") - 2);
+      section = name + "[" + std::to_string(seen[name]++) + "]";
+    } else if (line.rfind('[', 0) == 0) {
+      section = line.substr(1, line.find(']') - 1);
+    } else if (i == k) {
+      const std::size_t eq = line.find(" =");
+      if (eq == std::string::npos) return "";
+      return section + "." + line.substr(0, eq);
+    }
+  }
+  return "";
+}
+
+// Throws InputError naming the first setting of `scene_file` that differs
+// from the scene stored in the checkpoint. Both sides are resolved scenes,
+// so comments and spacing do not count. Checkpoints written before
+// 2026-11-29 store no scene and are not checked.
+void check_scene_unchanged(const fs::path& scene_file, const std::string& resolved,
+                           const std::vector<io::Blob>& blobs) {
+  const auto stored_blob = std::find_if(blobs.begin(), blobs.end(),
+                                        [](const io::Blob& b) { return b.name == kSceneBlob; });
+  if (stored_blob == blobs.end()) return;
+  const std::string stored = io::read_string_blob(*stored_blob);
+  if (stored == resolved) return;
+  const std::vector<std::string> now = lines_of(resolved), then = lines_of(stored);
+  std::size_t k = 0;
+  while (k < now.size() && k < then.size() && now[k] == then[k]) ++k;
+  const auto shown = [](const std::vector<std::string>& lines, std::size_t i) {
+    return i < lines.size() ? "`" + lines[i] + "`" : std::string("the end of the scene");
+  };
+  const std::string key = k < now.size() ? resolved_key(now, k) : resolved_key(then, k);
+  throw InputError(scene_file.string() + ": " + (key.empty() ? "" : "key '" + key + "': ") +
+                   "differs from the scene the checkpoint continues: " + shown(now, k) + ", was " +
+                   shown(then, k) +
+                   "; a restart continues the checkpointed run unchanged: restore the scene, or "
+                   "run the edited scene from the start");
 }
 
 void load_driver_blobs(const std::vector<io::Blob>& blobs, DriverState& st) {
@@ -312,6 +374,7 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
     const auto t0 = Clock::now();
     std::vector<io::Blob> blobs = sim->save_state();
     for (auto& b : driver_blobs(st, wall_so_far(), sim_stages())) blobs.push_back(std::move(b));
+    blobs.push_back(io::make_string_blob(std::string(kSceneBlob), scene.source_text));
     io::write_checkpoint(dir / "checkpoint.bin", blobs);
     stage_s[kStageOutput] += std::chrono::duration<double>(Clock::now() - t0).count();
   };
@@ -495,6 +558,7 @@ RunOutcome restart_run(const fs::path& dir, const RunOptions& options, std::ostr
   } catch (const std::exception& e) {
     throw InputError(e.what());
   }
+  check_scene_unchanged(scene_file, scene.source_text, blobs);
   return drive(scene, options, log, dir, &blobs);
 }
 

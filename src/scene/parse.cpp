@@ -242,11 +242,19 @@ class Field {
     if (!v_->is_integer()) wrong_type("an integer");
     return v_->as_integer();
   }
+  // toml11 reads an integer beyond 64 bits as the nearest 64-bit limit, so a
+  // limit in a message stands for "this or beyond".
+  static std::string integer_text(long long n) {
+    if (n == LLONG_MAX) return std::to_string(n) + " or more (beyond a 64-bit integer)";
+    if (n == LLONG_MIN) return std::to_string(n) + " or less (beyond a 64-bit integer)";
+    return std::to_string(n);
+  }
   int int_at_least(int lowest) const {
     const long long n = integer();
     if (n < lowest)
-      fail("expected an integer >= " + std::to_string(lowest) + ", got " + std::to_string(n));
-    if (n > INT_MAX) fail("expected an integer <= " + std::to_string(INT_MAX));
+      fail("expected an integer >= " + std::to_string(lowest) + ", got " + integer_text(n));
+    if (n > INT_MAX)
+      fail("expected an integer <= " + std::to_string(INT_MAX) + ", got " + integer_text(n));
     return static_cast<int>(n);
   }
   bool boolean() const {
@@ -816,7 +824,7 @@ class SceneReader {
         f.fail("expected " + expected + "; element [" + std::to_string(k) + "] is " + type_name(e));
       if (e.as_integer() < 1 || e.as_integer() > INT_MAX) {
         f.fail("expected " + expected + "; element [" + std::to_string(k) + "] is " +
-               std::to_string(e.as_integer()));
+               Field::integer_text(e.as_integer()));
       }
       scene_.grid.cells[k] = static_cast<int>(e.as_integer());
     }
@@ -982,6 +990,10 @@ class SceneReader {
     if (auto f = t.get("rotate")) {
       if (dim() == 3) f->fail("only for dimension = 2 (rotation about z of a 2D body)");
       b.rotate = f->number();
+      // Beyond a turn the angle adds nothing, and far beyond it (1e308) the
+      // degrees-to-radians product loses every digit of the angle.
+      if (std::abs(b.rotate) > 360.0)
+        f->fail("expected degrees from -360 to 360, got " + format_number(b.rotate));
     }
     if (auto f = t.get("pivot")) {
       if (dim() == 3) f->fail("only for dimension = 2 (the centre of `rotate`)");
