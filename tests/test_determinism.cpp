@@ -241,7 +241,7 @@ TEST(Determinism, ImperfectInterfaceNumericDnMUSL2D) {
       << "a compliant interface stores energy once it opens or slides";
 }
 
-// The largest tile edges the default picks (64 in 2D on grids from 705^2
+// The largest tile edges the default picks (64 in 2D on grids from 513^2
 // cells; 32 from 353^2), here forced on the 110 x 90 grid: 4 and 12
 // tiles, so one color holds one tile (one thread idle) or a few, and the
 // fused tail's per-thread L block holds up to 64^2 cells of particles.

@@ -1,7 +1,8 @@
 // The default tile edge (Stepper::setup_grid): the largest of 64, 32, 16,
 // 8, 4 in 2D (8, 4 in 3D) that leaves every one of the 2^D colors at least
-// 32 tiles (docs/performance.md "Tile edge of the whole step"); `tile` in
-// [grid] overrides it, rounded up to a power of two of at least 4.
+// 32 tiles, 20 at edge 64 (docs/performance.md "Tile edge of the whole
+// step", "Tile edge 64 from 513^2 cells"); `tile` in [grid] overrides it,
+// rounded up to a power of two of at least 4.
 // Exact integers, no tolerance.
 #include <gtest/gtest.h>
 
@@ -30,15 +31,17 @@ int tile_edge(int dim, int cells, const std::string& tile = "") {
 }
 
 TEST(TileEdge, DefaultKeepsThirtyTwoTilesPerColor2D) {
-  // 4 colors x 32 = 128 tiles: ceil(cells / T) >= 12 (11^2 = 121).
-  EXPECT_EQ(tile_edge(2, 40), 4);     // 10^2 = 100 tiles at 4, the smallest edge
-  EXPECT_EQ(tile_edge(2, 88), 4);     // 11^2 at 8
-  EXPECT_EQ(tile_edge(2, 89), 8);     // 12^2 at 8
-  EXPECT_EQ(tile_edge(2, 254), 16);   // the 250k bench scenes: 16^2 at 16, 8^2 at 32
-  EXPECT_EQ(tile_edge(2, 352), 16);   // 11^2 at 32
-  EXPECT_EQ(tile_edge(2, 353), 32);   // 12^2 at 32
+  // 4 colors x 32 = 128 tiles: ceil(cells / T) >= 12 (11^2 = 121) at T <= 32.
+  EXPECT_EQ(tile_edge(2, 40), 4);    // 10^2 = 100 tiles at 4, the smallest edge
+  EXPECT_EQ(tile_edge(2, 88), 4);    // 11^2 at 8
+  EXPECT_EQ(tile_edge(2, 89), 8);    // 12^2 at 8
+  EXPECT_EQ(tile_edge(2, 254), 16);  // the 250k bench scenes: 16^2 at 16, 8^2 at 32
+  EXPECT_EQ(tile_edge(2, 352), 16);  // 11^2 at 32
+  EXPECT_EQ(tile_edge(2, 353), 32);  // 12^2 at 32
+  // Edge 64 with 20 tiles per color, 80 tiles: ceil(cells / 64) >= 9.
   EXPECT_EQ(tile_edge(2, 504), 32);   // the 10^6 bench block: 8^2 at 64
-  EXPECT_EQ(tile_edge(2, 704), 32);   // 11^2 at 64
+  EXPECT_EQ(tile_edge(2, 512), 32);   // 8^2 at 64
+  EXPECT_EQ(tile_edge(2, 513), 64);   // 9^2 at 64
   EXPECT_EQ(tile_edge(2, 705), 64);   // 12^2 at 64
   EXPECT_EQ(tile_edge(2, 2000), 64);  // never beyond 64
 }

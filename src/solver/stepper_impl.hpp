@@ -72,7 +72,7 @@ void Stepper<D, Shape, Real>::setup_grid() {
     }
   }
   // Tile edge: the largest of 64, 32, 16, 8, 4 in 2D (8, 4 in 3D) that
-  // leaves every color at least 32 tiles. A thread's share of a color is
+  // leaves every color at least 32 tiles (20 at edge 64, below). A thread's share of a color is
   // cut at tile boundaries (TileSchedule), so the two threads' work differs
   // by up to one tile: with 8 tiles per color the 3D block of bench_step
   // (28 x 28 x 26 cells) stepped 1.5x faster on 2 threads, with 43 (edge
@@ -83,16 +83,22 @@ void Stepper<D, Shape, Real>::setup_grid() {
   // of the whole step"), while the 250k scenes, which 32 would leave 16
   // tiles per color, keep 16. Not beyond 64: the fused tail's per-thread
   // L block of one tile (64^2 cells x 4 particles x 32 B = 512 KiB) is
-  // half the L2 already. Chosen from the grid alone, never from the thread
-  // count, so the summation order (and the result) is the same for any
-  // number of threads.
+  // half the L2 already. Edge 64 needs only 20 tiles per color (2D grids
+  // from 513^2 cells, 705^2 before 2026-11-29): from 504^2 to 640^2 cells
+  // the 2D linear block stepped 6-13 % faster on one thread with 64 than
+  // with 32 and the same (+-2 %) on two; with 16 per color (451^2, 480^2)
+  // two threads lost 3-10 % (docs/performance.md "Tile edge 64 from 513^2
+  // cells"). Chosen from the grid alone, never from the thread count, so
+  // the summation order (and the result) is the same for any number of
+  // threads.
   int T = g.tile;
   if (T <= 0) {
     T = D == 2 ? 64 : 8;
     for (; T > 4; T /= 2) {
       std::size_t tiles = 1;
       for (int d = 0; d < D; ++d) tiles *= std::size_t((g.cells[d] + T - 1) / T);
-      if (tiles >= std::size_t(32) << D) break;
+      const std::size_t per_color = T == 64 ? 20 : 32;
+      if (tiles >= per_color << D) break;
     }
   }
   tiles_.setup(T, g.cells, scene_.simulation.particle_order == ParticleOrder::color);
