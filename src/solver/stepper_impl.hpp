@@ -71,26 +71,25 @@ void Stepper<D, Shape, Real>::setup_grid() {
         moments_.rr[std::size_t(k)] = gcols_.add_real("sep_rr" + std::to_string(k), n);
     }
   }
-  // Tile edge: the largest of 64, 32, 16, 8, 4 in 2D (8, 4 in 3D) that
-  // leaves every color at least 32 tiles (20 at edge 64, below). A thread's share of a color is
-  // cut at tile boundaries (TileSchedule), so the two threads' work differs
-  // by up to one tile: with 8 tiles per color the 3D block of bench_step
-  // (28 x 28 x 26 cells) stepped 1.5x faster on 2 threads, with 43 (edge
-  // 4) 1.9x. Within that limit larger tiles pay for the whole step: 2D
-  // linear with 10^6 particles (504^2 cells) steps 1.03-1.07x faster with
-  // 32 than with 16 (bench step_ab tile_16), with 3e6 (870^2 cells)
-  // 1.03-1.04x faster with 64 than with 32 (docs/performance.md "Tile edge
-  // of the whole step"), while the 250k scenes, which 32 would leave 16
-  // tiles per color, keep 16. Not beyond 64: the fused tail's per-thread
-  // L block of one tile (64^2 cells x 4 particles x 32 B = 512 KiB) is
-  // half the L2 already. Edge 64 needs only 20 tiles per color (2D grids
-  // from 513^2 cells, 705^2 before 2026-11-29): from 504^2 to 640^2 cells
-  // the 2D linear block stepped 6-13 % faster on one thread with 64 than
-  // with 32 and the same (+-2 %) on two; with 16 per color (451^2, 480^2)
-  // two threads lost 3-10 % (docs/performance.md "Tile edge 64 from 513^2
-  // cells"). Chosen from the grid alone, never from the thread count, so
-  // the summation order (and the result) is the same for any number of
-  // threads.
+  // Tile edge: the largest of 64, 32, 16, 8, 4 in 2D (8, 4 in 3D) that leaves
+  // every color at least 32 tiles (20 at edge 64, below). A thread's share of
+  // a color is cut at tile boundaries (TileSchedule), so the two threads' work
+  // differs by up to one tile: with 8 tiles per color the 3D block of
+  // bench_step (28 x 28 x 26 cells) stepped 1.5x faster on 2 threads, with 43
+  // (edge 4) 1.9x. Within that limit larger tiles pay for the whole step: 2D
+  // linear with 10^6 particles (504^2 cells) steps 1.03-1.07x faster with 32
+  // than with 16 (bench step_ab tile_16), with 3e6 (870^2 cells) 1.03-1.04x
+  // faster with 64 than with 32 (docs/performance.md "Tile edge of the whole
+  // step"), while the 250k scenes, which 32 would leave 16 tiles per color,
+  // keep 16. Not beyond 64: the fused tail's per-thread L block of one tile
+  // (64^2 cells x 4 particles x 32 B = 512 KiB) is half the L2 already. Edge
+  // 64 needs only 20 tiles per color (2D grids from 513^2 cells, 705^2 before
+  // 2026-11-29): from 504^2 to 640^2 cells the 2D linear block stepped 5-13 %
+  // faster on one thread with 64 than with 32 and the same on two (median
+  // ratios 0.97-0.98); with 16 per color (451^2, 480^2) two threads lost
+  // 1-38 % (docs/performance.md "Tile edge 64 from 513^2 cells"). Chosen
+  // from the grid alone, never from the thread count, so the summation
+  // order (and the result) is the same for any number of threads.
   int T = g.tile;
   if (T <= 0) {
     T = D == 2 ? 64 : 8;
