@@ -174,9 +174,8 @@ std::string resolved_key(const std::vector<std::string>& lines, std::size_t k) {
 // 2026-11-29 store no scene and are not checked.
 void check_scene_unchanged(const fs::path& scene_file, const std::string& resolved,
                            const std::vector<io::Blob>& blobs) {
-  const auto stored_blob = std::find_if(blobs.begin(), blobs.end(),
-                                        [](const io::Blob& b) { return b.name == kSceneBlob; });
-  if (stored_blob == blobs.end()) return;
+  const io::Blob* stored_blob = io::find_optional_blob(blobs, kSceneBlob);
+  if (!stored_blob) return;
   const std::string stored = io::read_string_blob(*stored_blob);
   if (stored == resolved) return;
   const std::vector<std::string> now = lines_of(resolved), then = lines_of(stored);
@@ -200,12 +199,11 @@ void load_driver_blobs(const std::vector<io::Blob>& blobs, DriverState& st) {
       io::read_scalar_blob<long>(io::find_blob(blobs, "driver.last_snapshot_step"));
   // Checkpoints written before 2026-11-26 carry no times: the summary then
   // covers the resumed segment only, as it did.
-  for (const io::Blob& b : blobs) {
-    if (b.name == "driver.wall_s") st.wall_before = io::read_scalar_blob<double>(b);
-    if (b.name == "driver.stages_s") {
-      io::read_blob(b, st.stages_before);
-      st.stages_before.resize(kStageCount, 0.0);
-    }
+  if (const io::Blob* b = io::find_optional_blob(blobs, "driver.wall_s"))
+    st.wall_before = io::read_scalar_blob<double>(*b);
+  if (const io::Blob* b = io::find_optional_blob(blobs, "driver.stages_s")) {
+    io::read_blob(*b, st.stages_before);
+    st.stages_before.resize(kStageCount, 0.0);
   }
   st.columns.assign(st.names.size(), {});
   for (std::size_t k = 0; k < st.names.size(); ++k)

@@ -129,10 +129,15 @@ std::vector<Blob> read_checkpoint(const std::filesystem::path& file) {
   return blobs;
 }
 
-const Blob& find_blob(const std::vector<Blob>& blobs, std::string_view name) {
+const Blob* find_optional_blob(const std::vector<Blob>& blobs, std::string_view name) {
   for (const Blob& blob : blobs) {
-    if (blob.name == name) return blob;
+    if (blob.name == name) return &blob;
   }
+  return nullptr;
+}
+
+const Blob& find_blob(const std::vector<Blob>& blobs, std::string_view name) {
+  if (const Blob* blob = find_optional_blob(blobs, name)) return *blob;
   throw std::runtime_error("checkpoint: no blob named '" + std::string(name) + "'");
 }
 

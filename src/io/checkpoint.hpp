@@ -85,6 +85,9 @@ std::vector<Blob> read_checkpoint(const std::filesystem::path& file);
 // Throws std::runtime_error("checkpoint: no blob named 'NAME'") if absent.
 const Blob& find_blob(const std::vector<Blob>& blobs, std::string_view name);
 
+// The blob named NAME, or nullptr: for blobs that older checkpoints lack.
+const Blob* find_optional_blob(const std::vector<Blob>& blobs, std::string_view name);
+
 // 64-bit FNV-1a; exposed for tests.
 std::uint64_t fnv1a64(std::string_view bytes);
 
