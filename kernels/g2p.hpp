@@ -12,6 +12,7 @@
 #include "kernels/constitutive.hpp"
 #include "kernels/g2p_packed.hpp"
 #include "kernels/g2p_particle.hpp"
+#include "kernels/grid_prefetch.hpp"
 #include "kernels/grid_update.hpp"
 #include "kernels/weight_batch.hpp"
 #include "kernels/weights.hpp"
@@ -316,6 +317,15 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
   const auto off =
       Windowed ? Window<D, Shape, Real>::offsets(G) : typename Window<D, Shape, Real>::Offsets{};
   using Weights = typename Gather::Weights;
+  // The windowed passes request the grid lines a line ahead; the pointwise
+  // kernel (grids too small for a window) does not.
+  GridLinesAhead<Window<D, Shape, Real>> ahead(Windowed && q.prefetch_grid,
+                                               Window<D, Shape, Real>::offsets(G));
+  for (int d = 0; d < D; ++d) {
+    ahead.read(V.vel[d]);
+    if constexpr ((What & kUpdateMotion) != 0) ahead.read(V.dvel[d]);
+    if constexpr (kScatter) ahead.write(G.p[d]);
+  }
   // When the momentum block and the gather's sums (2D vectors) do not fit in
   // the registers together (3D cubic B-splines in double: 8 units x 3 + 6),
   // the momenta of a batch are scattered after its gathers, by
@@ -371,6 +381,10 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
   auto build = [&](std::size_t first, std::size_t n, Weights * w, bool* ok)
       __attribute__((always_inline)) {
     st.build_batch(P, first, n, w, ok);
+    if constexpr (Windowed)
+      ahead.batch(n, [&](std::size_t i) {
+        return ok[i] ? w[i].base + field_offset<MultiField>(P, G, first + i) : SIZE_MAX;
+      });
     if constexpr (kPairs) {
       gathered.first = first;
       for (std::size_t i = 0; i < n;) {

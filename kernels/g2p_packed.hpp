@@ -28,6 +28,7 @@
 #include <utility>
 
 #include "kernels/g2p_particle.hpp"
+#include "kernels/grid_prefetch.hpp"
 #include "kernels/grid_update.hpp"
 #include "kernels/p2g_packed.hpp"
 #include "kernels/packed_linear.hpp"
@@ -154,6 +155,12 @@ G2PRangeResult g2p_range_packed(const ParticleView<2, Real>& particles,
   const Real dt = Real(q.dt), flip = Real(q.flip), pic = Real(1) - Real(q.flip);
   const WindowBuilder<2, LinearShape, Real> builder(G);
   const auto off = Win::offsets(G);
+  GridLinesAhead<Win> ahead(q.prefetch_grid, off);
+  for (int d = 0; d < 2; ++d) {
+    ahead.read(V.vel[d]);
+    if constexpr (kMotion) ahead.read(V.dvel[d]);
+    if constexpr (kScatter) ahead.write(G.p[d]);
+  }
   const Real inv_hx = builder.inverse_spacing(0), inv_hy = builder.inverse_spacing(1);
   PackedBatch<Real, K, MultiField> batch;
   Block carried;  // current == SIZE_MAX: nothing carried (kScatter only)
@@ -169,6 +176,7 @@ G2PRangeResult g2p_range_packed(const ParticleView<2, Real>& particles,
       // A run: consecutive particles with this window and field.
       const std::size_t b = batch.window(P, G, i);
       const std::size_t j = batch.run_end(P, G, i, b, n);
+      ahead.window(b);
       Block block;  // as in p2g_range_packed
       if constexpr (kScatter) {
         if (carried.current == b)

@@ -35,6 +35,7 @@ struct G2PParams {
   const unsigned char* rigid = nullptr;         // per field
   const double (*rigid_velocity)[3] = nullptr;  // per field, at t + dt
   double body_accel[3] = {0, 0, 0};             // for the external work of gravity
+  bool prefetch_grid = true;  // 2D: the grid lines a line ahead (kernels/grid_prefetch.hpp)
 };
 
 // Outcome of a G2P range: first bad particle (stencil off the grid or

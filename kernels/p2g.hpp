@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "kernels/grid_prefetch.hpp"
 #include "kernels/p2g_packed.hpp"
 #include "kernels/weight_batch.hpp"
 #include "kernels/weights.hpp"
@@ -96,6 +97,8 @@ std::size_t p2g_range_grouped(const ParticleView<D, Real>& particles, const Grid
   const Real inv_t = Real(opt.inv_thickness);
   const WindowBuilder<D, Shape, Real> builder(G);
   GroupedScatter<D, Shape, Real, What, Traction, UG, Units> scatter(G);
+  GridLinesAhead<Win> ahead(opt.prefetch_grid, Win::offsets(G));
+  add_scatter_arrays<What>(ahead, G);
   Win w[kWeightBatch];
   ScatterSourceBatch<D, Real> q;
   std::size_t base[kWeightBatch];
@@ -107,6 +110,7 @@ std::size_t p2g_range_grouped(const ParticleView<D, Real>& particles, const Grid
     while (ok < n && inside[ok]) ++ok;
     for (std::size_t i = 0; i < ok; ++i)
       base[i] = w[i].base + field_offset<MultiField>(P, G, first + i);
+    ahead.batch(ok, [&](std::size_t i) { return base[i]; });
     q.template fill<What, Traction>(P, opt, inv_t, first, ok);
     scatter.add(w, base, q, ok, ok == n && first + n < end);
     if (ok < n) return first + ok;  // nothing carried: `more` was false
@@ -132,9 +136,14 @@ std::size_t p2g_range_one_block(const ParticleView<D, Real>& particles,
   const auto off = Win::offsets(G);
   Block block;
   const WindowBuilder<D, Shape, Real> builder(G);
+  GridLinesAhead<Win> ahead(opt.prefetch_grid, off);
+  add_scatter_arrays<What>(ahead, G);
   auto build = [&](std::size_t first, std::size_t n, Win * w, bool* ok)
       __attribute__((always_inline)) {
     builder.build_batch(P, first, n, w, ok);
+    ahead.batch(n, [&](std::size_t i) {
+      return ok[i] ? w[i].base + field_offset<MultiField>(P, G, first + i) : SIZE_MAX;
+    });
   };
   auto scatter = [&](std::size_t p, const Win* win) __attribute__((always_inline)) {
     if (!win) return false;

@@ -28,6 +28,7 @@
 #include <cstdint>
 #include <type_traits>
 
+#include "kernels/grid_prefetch.hpp"
 #include "kernels/packed_linear.hpp"
 #include "kernels/window_block.hpp"
 
@@ -174,6 +175,8 @@ std::size_t p2g_range_packed(const ParticleView<2, Real>& particles, const GridV
   const GridView<2, Real> G = grid;
   const WindowBuilder<2, LinearShape, Real> builder(G);
   const auto off = Block::Win::offsets(G);
+  GridLinesAhead<typename Block::Win> ahead(opt.prefetch_grid, off);
+  add_scatter_arrays<What>(ahead, G);
   const Real inv_t = Real(opt.inv_thickness);
   const Real inv_hx = builder.inverse_spacing(0), inv_hy = builder.inverse_spacing(1);
   PackedBatch<Real, K, MultiField> batch;
@@ -188,6 +191,7 @@ std::size_t p2g_range_packed(const ParticleView<2, Real>& particles, const GridV
       }
       const std::size_t b = batch.window(P, G, i);
       const std::size_t j = batch.run_end(P, G, i, b, n);
+      ahead.window(b);
       // (Written out here and in g2p_range_packed: as member functions
       // of the block these made GCC keep the block in memory, and the
       // packed fused G2P went 8.1 -> 10.1 ns/particle.)

@@ -26,6 +26,7 @@ enum P2GWhat : unsigned {
 struct P2GOptions {
   bool position_separation = false;  // mx holds positions (else displacements)
   double inv_thickness = 1.0;        // 2D: Omega and g are areas (P-19, P-33)
+  bool prefetch_grid = true;         // 2D: the grid lines a line ahead (kernels/grid_prefetch.hpp)
 };
 
 // The per-particle factors a transfer scatters (ALGORITHM §1-2).

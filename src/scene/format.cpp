@@ -118,6 +118,10 @@ void write_simulation(Writer& w, const Scene& s) {
   w.boolean("fuse_constitutive", sim.fuse_constitutive);
   w.boolean("fuse_step_tail", sim.fuse_step_tail);
   w.boolean("skip_empty_nodes", sim.skip_empty_nodes);
+  // Written only when off: a scene resolved before the key existed (the
+  // scene a checkpoint stores, run_driver.cpp) stays equal to its
+  // re-resolved self.
+  if (!sim.prefetch_grid) w.boolean("prefetch_grid", false);
   w.word("particle_order", sim.particle_order);
   w.boolean("compensated_positions", sim.compensated_positions);
   w.num("mm_fields_share", sim.mm_fields_share);

@@ -663,10 +663,26 @@ class SceneReader {
 
   // -------------------------------------------------------- [simulation]
   void read_simulation(const Table& t) {
-    t.only({"name", "dimension", "plane", "thickness", "end_time", "cfl", "dt", "scheme", "flip",
-            "precision", "default_law", "force", "sort_every", "fuse_constitutive",
-            "compensated_positions", "fuse_step_tail", "mm_fields_share", "particle_order",
-            "skip_empty_nodes"});
+    t.only({"name",
+            "dimension",
+            "plane",
+            "thickness",
+            "end_time",
+            "cfl",
+            "dt",
+            "scheme",
+            "flip",
+            "precision",
+            "default_law",
+            "force",
+            "sort_every",
+            "fuse_constitutive",
+            "compensated_positions",
+            "fuse_step_tail",
+            "mm_fields_share",
+            "particle_order",
+            "skip_empty_nodes",
+            "prefetch_grid"});
     SimulationSpec& sim = scene_.simulation;
     const Field d = t.need("dimension");
     const long long dimension = d.integer();
@@ -705,6 +721,7 @@ class SceneReader {
     if (auto f = t.get("compensated_positions")) sim.compensated_positions = f->boolean();
     if (auto f = t.get("fuse_step_tail")) sim.fuse_step_tail = f->boolean();
     if (auto f = t.get("skip_empty_nodes")) sim.skip_empty_nodes = f->boolean();
+    if (auto f = t.get("prefetch_grid")) sim.prefetch_grid = f->boolean();
     if (auto f = t.get("particle_order")) sim.particle_order = f->choice(kParticleOrderNames);
     if (auto f = t.get("mm_fields_share")) {
       sim.mm_fields_share = f->number();

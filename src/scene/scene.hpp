@@ -75,6 +75,10 @@ struct SimulationSpec {
   // bitwise (docs/performance.md "Node passes over the nodes a field can
   // reach"). false: every node of every field.
   bool skip_empty_nodes = true;
+  // 2D transfers request the grid lines their windows reach next, a line
+  // ahead in x; same results, bitwise (kernels/grid_prefetch.hpp,
+  // docs/performance.md "Grid lines a line ahead"). false: no requests.
+  bool prefetch_grid = true;
   // How the particles are stored between sorts: tile by tile, color by color
   // (each colored pass reads its particles front to back), or in plain tile
   // order. Same results but for the order of sums over particles

@@ -85,6 +85,8 @@ class Stepper final : public Simulation {
   GridView<D, Real>& grid() { return G_; }
   MultimaterialStage<D, Real>& multimaterial() { return mm_; }
   const NodeOwnership& ownership() const { return own_; }
+  // Whether the 2D transfers request grid lines ahead (stepper_impl.hpp).
+  bool prefetch_grid() const;
   // For tests: the shortest gap the node runs skip (kernels/active_nodes.hpp,
   // kMinSkippedNodes), from the next re-sort on, which this asks for.
   void set_min_skipped_nodes(std::size_t n) {

@@ -1,0 +1,114 @@
+// [simulation] prefetch_grid (default true): the 2D transfers request the
+// grid lines their windows reach next (kernels/grid_prefetch.hpp). A request
+// is a hint, so runs with and without it must agree bit for bit, on one and
+// two threads, for every 2D kernel that requests: the packed linear P2G and
+// G2P (one and two fields, double and float), the windowed uGIMP transfers
+// with the multimaterial arrays, and the grouped scatter of cubic B-splines.
+// The solver requests only on grids of kPrefetchMinGridBytes and more, so
+// the scenes here run on grids enlarged past the bodies (the same
+// particles). The key is written back by format_scene only when off, so a
+// scene resolved before it existed (a checkpoint's) re-resolves to the same
+// text.
+#include <gtest/gtest.h>
+#include <omp.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "bitwise_same.hpp"
+#include "kernels/grid_prefetch.hpp"
+#include "kernels/shape.hpp"
+#include "kernels/window.hpp"
+#include "scene/format.hpp"
+#include "scene/parse.hpp"
+#include "solver/simulation.hpp"
+#include "solver/stepper.hpp"
+
+namespace {
+
+using namespace mmpm;
+using mmpm::testing::expect_bitwise_same;
+
+const std::string kInputs = std::string(MMPM_SOURCE_DIR) + "/inputs/";
+
+std::unique_ptr<Simulation> make(const std::string& file, std::vector<std::string> sets, bool on) {
+  sets.push_back(std::string("simulation.prefetch_grid=") + (on ? "true" : "false"));
+  return make_simulation(parse_scene_file(kInputs + file, sets));
+}
+
+void expect_same_with_and_without(const std::string& file, const std::vector<std::string>& sets,
+                                  int steps) {
+  const int saved = omp_get_max_threads();
+  for (int threads : {1, 2}) {
+    omp_set_num_threads(threads);
+    const std::string what =
+        file + " " + ::testing::PrintToString(sets) + ", " + std::to_string(threads) + " thread(s)";
+    auto on = make(file, sets, true), off = make(file, sets, false);
+    for (int s = 1; s <= steps; ++s) {
+      on->step();
+      off->step();
+      if (s % 10 == 0 || s == steps)
+        expect_bitwise_same(*on, *off, what + ", step " + std::to_string(s));
+      if (::testing::Test::HasFailure()) break;
+    }
+  }
+  omp_set_num_threads(saved);
+}
+
+TEST(GridPrefetch, TwoLayerInterfaceBitwise) {
+  // uGIMP windows, two fields, mx and Omega scattered with the forces.
+  expect_same_with_and_without("two_layer.toml", {"grid.cells=[120, 120]"}, 40);
+}
+
+TEST(GridPrefetch, PackedLinearBitwise) {
+  // The packed 2D linear kernels (MUSL's three passes), two fields in contact.
+  const std::string big = "grid.cells=[150, 150]";
+  expect_same_with_and_without("shear_blocks.toml", {big, "grid.shape=\"linear\""}, 40);
+  expect_same_with_and_without(
+      "shear_blocks.toml", {big, "grid.shape=\"linear\"", "simulation.precision=\"float\""}, 40);
+  expect_same_with_and_without("shear_blocks.toml",
+                               {big, "grid.shape=\"linear\"", "simulation.scheme=\"USL\""}, 40);
+}
+
+TEST(GridPrefetch, CubicBsplinesBitwise) {
+  // The widest 2D window (4 x 4 nodes).
+  expect_same_with_and_without("collision.toml",
+                               {"grid.cells=[200, 100]", "grid.shape=\"bspline3\""}, 30);
+}
+
+TEST(GridPrefetch, OnlyOnGridsPastTheL2) {
+  auto on = [](std::vector<std::string> sets) {
+    auto sim = make_simulation(parse_scene_file(kInputs + "two_layer.toml", sets));
+    auto* stepper = dynamic_cast<Stepper<2, GimpShape, double>*>(sim.get());
+    EXPECT_NE(stepper, nullptr);
+    return stepper && stepper->prefetch_grid();
+  };
+  // 41 x 89 nodes, 2 fields, 9 arrays of doubles: 0.50 MiB.
+  EXPECT_FALSE(on({}));
+  // 121 x 121 nodes: 2.0 MiB.
+  EXPECT_TRUE(on({"grid.cells=[120, 120]"}));
+  EXPECT_FALSE(on({"grid.cells=[120, 120]", "simulation.prefetch_grid=false"}));
+}
+
+TEST(GridPrefetch, WrittenBackOnlyWhenOff) {
+  const Scene on = parse_scene_file(kInputs + "two_layer.toml", {});
+  EXPECT_TRUE(on.simulation.prefetch_grid);
+  EXPECT_EQ(format_scene(on).find("prefetch_grid"), std::string::npos);
+  const Scene off =
+      parse_scene_file(kInputs + "two_layer.toml", {"simulation.prefetch_grid=false"});
+  EXPECT_FALSE(off.simulation.prefetch_grid);
+  const std::string text = format_scene(off);
+  EXPECT_NE(text.find("prefetch_grid = false"), std::string::npos) << text;
+  EXPECT_FALSE(parse_scene_text(text, "resolved.toml", {}).simulation.prefetch_grid);
+}
+
+TEST(GridPrefetch, OnlyIn2D) {
+  using W2 = Window<2, LinearShape, double>;
+  using W3 = Window<3, LinearShape, double>;
+  EXPECT_TRUE(GridLinesAhead<W2>(true, typename W2::Offsets{}).on());
+  EXPECT_FALSE(GridLinesAhead<W2>(false, typename W2::Offsets{}).on());
+  EXPECT_FALSE(GridLinesAhead<W3>(true, typename W3::Offsets{}).on());
+}
+
+}  // namespace
