@@ -469,6 +469,10 @@ PAIRED_SETTINGS = [
     ("tile_16", "Tile edge 16 on the 504² grid, paired blocks (B: grid.tile = 16)",
      "A with the defaults (tile edge 32 on this grid, 64 tiles per color) and B with 16 (the "
      "edge of every 2D grid before 2026-11-26)", "the default 32 is faster", "p2g"),
+    ("prefetch_grid_false", "Grid lines requested a line ahead, paired blocks "
+     "(B: prefetch_grid = false)",
+     "A with the defaults (the 2D transfers request the grid lines their windows reach next, on "
+     "grids of 1 MiB and more) and B without the requests", "the requests are faster", "g2p"),
     ("same_settings", "Control: two Simulations with the same settings, paired blocks",
      "A and B both with the defaults (B made after A): what the harness itself puts between two "
      "equal runs, the scale against which the rows above are read", "A is slower", "g2p"),
