@@ -156,11 +156,7 @@ G2PRangeResult g2p_range_packed(const ParticleView<2, Real>& particles,
   const WindowBuilder<2, LinearShape, Real> builder(G);
   const auto off = Win::offsets(G);
   GridLinesAhead<Win> ahead(q.prefetch_grid, off);
-  for (int d = 0; d < 2; ++d) {
-    ahead.read(V.vel[d]);
-    if constexpr (kMotion) ahead.read(V.dvel[d]);
-    if constexpr (kScatter) ahead.write(G.p[d]);
-  }
+  add_gather_arrays<What>(ahead, G, V);
   const Real inv_hx = builder.inverse_spacing(0), inv_hy = builder.inverse_spacing(1);
   PackedBatch<Real, K, MultiField> batch;
   Block carried;  // current == SIZE_MAX: nothing carried (kScatter only)

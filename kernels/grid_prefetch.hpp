@@ -24,6 +24,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "kernels/g2p_particle.hpp"
+#include "kernels/grid_update.hpp"
 #include "kernels/grid_view.hpp"
 #include "kernels/window_block.hpp"
 
@@ -101,6 +103,18 @@ void add_scatter_arrays(GridLinesAhead<Win>& ahead, const GridView<D, Real>& G) 
     if constexpr ((What & kForce) != 0) ahead.write(G.f[d]);
     if constexpr ((What & kMultimaterial) != 0) ahead.write(G.mx[d]);
     if constexpr ((What & kDomainGradient) != 0) ahead.write(G.g[d]);
+  }
+}
+
+// The arrays a gather of `What` (kernels/g2p_particle.hpp) reads, and the
+// momenta MUSL's velocity pass adds to.
+template <unsigned What, class Win, int D, class Real>
+void add_gather_arrays(GridLinesAhead<Win>& ahead, const GridView<D, Real>& G,
+                       const GridVelocity<D, Real>& V) {
+  for (int d = 0; d < D; ++d) {
+    ahead.read(V.vel[d]);
+    if constexpr ((What & kUpdateMotion) != 0) ahead.read(V.dvel[d]);
+    if constexpr ((What & kScatterMomentum) != 0) ahead.write(G.p[d]);
   }
 }
 
