@@ -39,7 +39,12 @@
 
 namespace mmpm {
 
-inline constexpr std::size_t kParallelNodes = 1024;
+// The passes run on a team from two chunks of the list up (a chunk is
+// PairBatch::kLanes = 64 nodes; one chunk leaves the second thread idle).
+// The two-layer scene's 250-490 interface nodes gain 1.9x on two threads
+// (docs/performance.md, "The multimaterial pass on two threads from 128
+// nodes"); the threshold was 1024 until 2026-11-29.
+inline constexpr std::size_t kParallelNodes = 128;
 
 // One material at a node, or the lump of several ("virtual b", §3, §6).
 template <int D, class Real>
@@ -797,8 +802,7 @@ void run_pass(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
   for (std::size_t c = 0; c < chunks; ++c) partial[c].reaction = &reactions[c * reaction_stride];
   std::vector<ChunkCursor> cursor;
 
-  // A node costs a few hundred ns: below ~1000 nodes one thread is faster
-  // than waking a team.
+  static_assert(kParallelNodes >= 2 * kChunk, "a team needs two chunks to share");
 #pragma omp parallel if (n >= kParallelNodes)
   {
     const std::size_t team = std::size_t(omp_get_num_threads());

@@ -6,7 +6,7 @@
 // Tolerance: none (memcmp of the values). Resolution: every scene has more
 // than 8192 particles and more than 8192 grid nodes, so that the solver's
 // parallel regions (which switch on at kParallelMin = 8192) really run on 2
-// threads: 2D scenes 110 x 90 cells of 1 mm (10101 nodes) with 12000-14400
+// threads: 2D scenes 110 x 90 cells of 1 mm (10101 nodes) with 12000-19200
 // particles (2 per cell and direction); the 3D scene 24 x 22 x 22 cells
 // (13225 nodes) with 13824 particles. The initial velocity field is
 // non-uniform (so stresses build up at once) and fast enough (~0.5-1 cell in
@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "kernels/multimaterial.hpp"
 #include "scene/parse.hpp"
 #include "solver/simulation.hpp"
 #include "test_util.hpp"
@@ -227,9 +228,14 @@ TEST(Determinism, SingleMaterialBSpline2DMirrorSupport) {
 }
 
 TEST(Determinism, ImperfectInterfacePerfectNormal2D) {
-  const RunResult r =
-      check_scene(two_materials("double", kPerfectNormalInterface).text(), "2D gimp double", 40.0);
-  EXPECT_GT(r.counters.multimaterial_nodes, 0) << "the multimaterial pass must be active";
+  // Bodies 80 cells tall: the interface's ~160 multimaterial nodes reach
+  // kParallelNodes, so the multimaterial passes run on the team (60 cells
+  // give 124 nodes, which one thread takes).
+  BoxScene2D s = two_materials("double", kPerfectNormalInterface);
+  s.b0_max[1] = s.b1_max[1] = 84;
+  const RunResult r = check_scene(s.text(), "2D gimp double", 40.0);
+  EXPECT_GE(r.counters.multimaterial_nodes, long(kParallelNodes))
+      << "the multimaterial passes must run on two threads";
 }
 
 TEST(Determinism, ImperfectInterfaceNumericDnMUSL2D) {
