@@ -41,9 +41,10 @@ namespace mmpm {
 
 // The passes run on a team from two chunks of the list up (a chunk is
 // PairBatch::kLanes = 64 nodes; one chunk leaves the second thread idle).
-// The two-layer scene's 250-490 interface nodes gain 1.9x on two threads
-// (docs/performance.md, "The multimaterial pass on two threads from 128
-// nodes"); the threshold was 1024 until 2026-11-29.
+// With the threshold at 1024 the two-layer scene's 250-490 interface nodes
+// ran on one thread: its stage alone took 33-37 us per step on two threads
+// and 43-45 on one; from 128, 22-24 (docs/performance.md, "The
+// multimaterial pass on two threads from 128 nodes").
 inline constexpr std::size_t kParallelNodes = 128;
 
 // One material at a node, or the lump of several ("virtual b", §3, §6).
