@@ -801,41 +801,46 @@ void run_pass(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
   std::vector<ChunkStats> partial(chunks);
   std::vector<double> reactions(chunks * reaction_stride, 0.0);
   for (std::size_t c = 0; c < chunks; ++c) partial[c].reaction = &reactions[c * reaction_stride];
-  std::vector<ChunkCursor> cursor;
+  // A chunk belongs to the thread that owns its first node
+  // (kernels/node_ownership.hpp): P2G wrote that node's fields from this
+  // thread's tiles, so they are in its cache. Handed out dynamically, about
+  // half of the chunks' grid lines crossed between the cores. A thread done
+  // with its own chunks takes the others' next ones: the multimaterial
+  // nodes may lie mostly in one thread's part (one straight interface).
+  // The cursors are set before the team starts, for the team the region
+  // will have, so the region has no barrier before its chunks (it had an
+  // `omp single`; the stage alone measured 22.6-23.4 us per step against
+  // 23.3-23.7 with it, docs/performance.md "The multimaterial pass on two
+  // threads from 128 nodes"). A team of another size still takes every
+  // chunk: each thread walks all the cursors.
+  const bool parallel = n >= kParallelNodes;
+  const std::size_t planned = parallel ? std::size_t(std::max(1, omp_get_max_threads())) : 1;
+  std::vector<ChunkCursor> cursor(planned);
+  {
+    auto first_chunk = [&](std::size_t i) {
+      if (i == planned) return chunks;
+      const std::size_t node = own.range(grid.nodes, planned, i).first;
+      const auto k = std::size_t(std::lower_bound(list.begin(), list.end(), node) - list.begin());
+      return (k + kChunk - 1) / kChunk;
+    };
+    for (std::size_t i = 0; i < planned; ++i) {
+      cursor[i].next.store(first_chunk(i), std::memory_order_relaxed);
+      cursor[i].last = first_chunk(i + 1);
+    }
+  }
 
   static_assert(kParallelNodes >= 2 * kChunk, "a team needs two chunks to share");
-#pragma omp parallel if (n >= kParallelNodes)
+#pragma omp parallel if (parallel)
   {
-    const std::size_t team = std::size_t(omp_get_num_threads());
     const std::size_t me = std::size_t(omp_get_thread_num());
-    // A chunk belongs to the thread that owns its first node
-    // (kernels/node_ownership.hpp): P2G wrote that node's fields from this
-    // thread's tiles, so they are in its cache. Handed out dynamically, about
-    // half of the chunks' grid lines crossed between the cores. A thread done
-    // with its own chunks takes the others' next ones: the multimaterial
-    // nodes may lie mostly in one thread's part (one straight interface).
-#pragma omp single
-    {
-      cursor = std::vector<ChunkCursor>(team);
-      auto first_chunk = [&](std::size_t i) {
-        if (i == team) return chunks;
-        const std::size_t node = own.range(grid.nodes, team, i).first;
-        const auto k = std::size_t(std::lower_bound(list.begin(), list.end(), node) - list.begin());
-        return (k + kChunk - 1) / kChunk;
-      };
-      for (std::size_t i = 0; i < team; ++i) {
-        cursor[i].next.store(first_chunk(i), std::memory_order_relaxed);
-        cursor[i].last = first_chunk(i + 1);
-      }
-    }
     NodeFields<D, Real> nf;
     const auto batch = std::make_unique<PairBatch<D, Real>>();
     // A chunk's statistics are summed in the thread's own copy and stored
     // once per chunk: neighbouring chunks' entries share cache lines, and
     // updating them node by node from two threads was slower than one thread.
     std::vector<double> reaction(reaction_stride);
-    for (std::size_t step = 0; step < team; ++step) {
-      ChunkCursor& from = cursor[(me + step) % team];
+    for (std::size_t step = 0; step < planned; ++step) {
+      ChunkCursor& from = cursor[(me + step) % planned];
       for (;;) {
         const std::size_t c = from.next.fetch_add(1, std::memory_order_relaxed);
         if (c >= from.last) break;
