@@ -198,6 +198,10 @@ const BadInput kBadInputs[] = {
      "rotate   = 1e308"},
     {"cells_beyond_64_bits", "cells  = ", "cells  = [99999999999999999999, 6]", "grid.cells",
      "99999999999999999999"},
+    // Found by a fuzzing session (2026-11-29): a number key read such an
+    // integer as 9.2e18 and ran with it.
+    {"number_beyond_64_bits", "E ", "E       = 99999999999999999999", "material[0].E",
+     "99999999999999999999"},
 };
 
 class CliBadInput : public ::testing::TestWithParam<BadInput> {};

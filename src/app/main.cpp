@@ -27,7 +27,7 @@ int check_scene(const std::string& file, const std::vector<std::string>& sets) {
             << ", material fields: " << sim->field_count() << ", tile: " << sim->tile_edge()
             << " cells\n"
             << "# dt: " << dt << " (stability limit " << crit << ", cfl " << dt / crit
-            << "), steps: " << long(std::ceil(scene.simulation.end_time / dt - 1e-9)) << "\n";
+            << "), steps: " << planned_steps(scene.simulation.end_time, dt) << "\n";
   if (dt > crit * (1 + 1e-12))
     std::cerr
         << file << ": warning: key 'simulation." << (scene.simulation.dt ? "dt" : "cfl")
@@ -150,6 +150,12 @@ int main(int argc, char** argv) {
   } catch (const mmpm::InputError& e) {
     std::cerr << e.what() << "\n";
     return 2;
+  } catch (const std::bad_alloc&) {
+    // Past the scene's memory estimate (scene/parse.cpp), e.g. a limit
+    // the estimate cannot see; the run's outputs stay marked partial.
+    std::cerr << "mmpm: error: out of memory: the scene needs more memory than this process "
+                 "was given; use fewer particles or cells, or raise the limit\n";
+    return 3;
   } catch (const std::exception& e) {
     std::cerr << "mmpm: error: " << e.what() << "\n";
     return 3;

@@ -319,7 +319,16 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
                        "scene again");
     }
     load_driver_blobs(*resume, st);
-    writer = std::make_unique<io::RunWriter>(io::RunWriter::reopen(dir, st.last_snapshot_step));
+    try {
+      writer = std::make_unique<io::RunWriter>(io::RunWriter::reopen(dir, st.last_snapshot_step));
+    } catch (const std::exception& e) {
+      // The snapshots so far are part of what the restart directory must
+      // hold, as the checkpoint is: missing or damaged, it is bad input.
+      // (The message names the file.)
+      throw InputError(std::string(e.what()) +
+                       "; the restart needs the snapshots the run wrote before its checkpoint; "
+                       "run the scene again from the start");
+    }
   } else {
     fs::remove(dir / "summary.json");
     fs::remove(dir / "checkpoint.bin");
@@ -349,7 +358,11 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
   long output_calls = 0;
   auto snapshot_if_due = [&](bool final) {
     const double t = sim->time();
-    const bool due = every > 0 && t >= double(st.next_snapshot) * every - 0.5 * sim->dt();
+    // Half a step early counts as on time; with steps longer than `every`
+    // half of `every` (every step is then due): half of a step of 1e308
+    // put every snapshot time in the past, and the loop below never ended.
+    const double early = 0.5 * std::min(sim->dt(), every);
+    const bool due = every > 0 && t >= double(st.next_snapshot) * every - early;
     if (!(due || (final && st.last_snapshot_step != sim->step_count()))) return;
     const auto t0 = Clock::now();
     io::Snapshot snapshot = sim->snapshot(o.fields);
@@ -361,9 +374,9 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
       // below dt a loop of single increments would run (t + dt / 2) / every
       // times (2.5e11 for every = 1e-12 ms, a hang); the loops after the
       // jump only absorb the division's rounding.
-      const double k = std::floor((t + 0.5 * sim->dt()) / every);
+      const double k = std::floor((t + early) / every);
       if (k > double(st.next_snapshot)) st.next_snapshot = static_cast<long>(k);
-      while (double(st.next_snapshot) * every - 0.5 * sim->dt() <= t) ++st.next_snapshot;
+      while (double(st.next_snapshot) * every - early <= t) ++st.next_snapshot;
     }
     stage_s[kStageOutput] += std::chrono::duration<double>(Clock::now() - t0).count();
     ++output_calls;
@@ -401,7 +414,8 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
   auto last_ckpt = Clock::now();
   std::optional<Energies> final_energies;
   try {
-    while (sim->time() < end_time - 1e-9 * sim->dt()) {
+    const double end_tolerance = end_time_tolerance(end_time, sim->dt());
+    while (sim->time() < end_time - end_tolerance) {
       sim->step_within(end_time);
       const long s = sim->step_count();
       bool stop = false;
@@ -448,7 +462,7 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
         std::ostringstream m;
         m << "interrupted by " << signal_name(sig) << " at step " << s << " (t = " << sim->time()
           << " of " << end_time << "); checkpoint written: continue with `mmpm run --restart "
-          << dir.string() << "`";
+          << dir.string() << (opt.force ? " --force" : "") << "`";
         out.exit_code = 128 + sig;
         out.message = m.str();
         return out;

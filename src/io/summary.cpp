@@ -9,7 +9,7 @@
 namespace mmpm::io {
 
 void write_summary(const std::filesystem::path& file, const nlohmann::json& j) {
-  write_file_atomic(file, j.dump(2) + "\n");
+  write_file_atomic(file, j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n");
 }
 
 nlohmann::json read_summary(const std::filesystem::path& file) {

@@ -255,7 +255,7 @@ ParticleSeeds make_particles(const Scene& scene) {
       if (scene.bodies[b].name == load.body) bi = int(b);
     const BodySpec& body = scene.bodies[std::size_t(bi)];
     if (body.shape != BodyShape::box)
-      throw InputError(located(load.where.file, load.where.line, "where",
+      throw InputError(located(load.where.file, load.where.line, load.where.key + ".where",
                                "traction loads act on box bodies only"));
     const int ax = load.face_axis;
     const double spacing = scene.grid.cell[std::size_t(ax)] / body.particles_per_cell;
@@ -271,6 +271,15 @@ ParticleSeeds make_particles(const Scene& scene) {
       const double u = to_body_frame(body, out.x[p])[std::size_t(ax)];
       if (std::abs(u - extreme) < 0.5 * spacing) face.push_back(p);
     }
+    // A body the later bodies replaced everywhere (allowed: an inclusion
+    // inside a later, larger one) has no face: the load would act on
+    // nothing, and such a scene ran to exit 0 with zero external work.
+    if (face.empty())
+      throw InputError(located(load.where.file, load.where.line, load.where.key + ".where",
+                               "body \"" + body.name +
+                                   "\" holds no particle: the bodies listed after it replace every "
+                                   "one of its particles (where bodies overlap, the later one "
+                                   "wins), so this traction would act on nothing"));
     double area = dim == 2 ? scene.simulation.thickness : 1.0;
     for (int d = 0; d < dim; ++d)
       if (d != ax) area *= body.max[d] - body.min[d];
@@ -290,7 +299,7 @@ ParticleSeeds make_particles(const Scene& scene) {
                                     std::abs(normal[d]));
     for (std::size_t p : face) {
       if (out.load[p] >= 0)
-        throw InputError(located(load.where.file, load.where.line, "where",
+        throw InputError(located(load.where.file, load.where.line, load.where.key + ".where",
                                  "two traction loads act on the same particles"));
       out.load[p] = int(li);
       // On a grid-aligned face the discrete body ends at its particles'

@@ -1,11 +1,13 @@
 #include "scene/parse.hpp"
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
 #include <climits>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -161,6 +163,12 @@ std::string condense_toml_error(const std::string& what) {
     const auto colon = line.find(": ");
     if (colon != std::string::npos) line.erase(0, colon + 2);
   }
+  // Some messages start with the reader's function ("parse_ml_basic_string:
+  // invalid utf8 sequence found"): a name that means nothing to the user.
+  if (const auto colon = line.find(": ");
+      colon != std::string::npos && line.starts_with("parse_") &&
+      line.find_first_not_of("abcdefghijklmnopqrstuvwxyz_") == colon)
+    line.erase(0, colon + 2);
   std::string out = line;
   if (!out.empty() && out.back() == '.') out.pop_back();
   std::vector<std::string> hints;
@@ -206,7 +214,13 @@ class Field {
   double number() const {
     double x = 0;
     if (v_->is_integer()) {
-      x = static_cast<double>(v_->as_integer());
+      // An integer past 64 bits reads as the limit (integer_text): taken
+      // as a number, 1e20 written 100000000000000000000 became 9.2e18.
+      const long long n = v_->as_integer();
+      if (n == LLONG_MAX || n == LLONG_MIN)
+        fail("expected a number, got the integer " + integer_text(n) +
+             "; write it as a float, e.g. 1e20");
+      x = static_cast<double>(n);
     } else if (v_->is_floating()) {
       x = v_->as_floating();
     } else {
@@ -504,10 +518,26 @@ double body_measure(const BodySpec& b, int dim, const Bounds& clipped) {
   return std::min(shape, box);
 }
 
-// Bytes of RAM on this machine (0 when unknown: no check then).
-double physical_memory() {
+// Bytes this process may use (0 when unknown: no check then): the
+// machine's RAM, or less under an address-space limit (ulimit -v) or a
+// cgroup's memory.max. With RAM alone, `check` of a scene past a 6 GB
+// ulimit built its particles until std::bad_alloc.
+double usable_memory() {
   const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
-  return pages > 0 && page > 0 ? double(pages) * double(page) : 0.0;
+  double have = pages > 0 && page > 0 ? double(pages) * double(page) : 0.0;
+  auto lower_to = [&](double limit) {
+    if (limit > 0) have = have > 0 ? std::min(have, limit) : limit;
+  };
+  rlimit as{};
+  if (getrlimit(RLIMIT_AS, &as) == 0 && as.rlim_cur != RLIM_INFINITY) lower_to(double(as.rlim_cur));
+  std::ifstream cgroup("/sys/fs/cgroup/memory.max");
+  std::string word;
+  if (cgroup >> word && word != "max") {
+    char* end = nullptr;
+    const double limit = std::strtod(word.c_str(), &end);
+    if (end && *end == '\0') lower_to(limit);
+  }
+  return have;
 }
 
 std::string bounds_text(const Bounds& b, int dim) {
@@ -597,6 +627,7 @@ class SceneReader {
       throw InputError(
           located(src_.label(), 0, "body", "missing: a scene needs at least one [[body]]"));
     }
+    if (scene_.simulation.precision == Precision::float32) check_float_range();
     for (const Table& t : sections(top, "interaction")) add_interaction(t);
     // One separation method per scene: the interactions that do not name
     // one take the method another names (else the default, displacement).
@@ -713,7 +744,10 @@ class SceneReader {
       if (sim.flip < 0 || sim.flip > 1)
         f->fail("expected a number in [0, 1], got " + format_number(sim.flip));
     }
-    if (auto f = t.get("precision")) sim.precision = f->choice(kPrecisionNames);
+    if (auto f = t.get("precision")) {
+      sim.precision = f->choice(kPrecisionNames);
+      precision_where_ = f->where();
+    }
     if (auto f = t.get("default_law")) sim.default_law = f->choice(kDefaultLawNames);
     if (auto f = t.get("force")) sim.force = f->boolean();
     if (auto f = t.get("sort_every")) sim.sort_every = f->int_at_least(0);
@@ -728,8 +762,46 @@ class SceneReader {
       if (sim.mm_fields_share < 0 || sim.mm_fields_share > 1)
         f->fail("expected a number in [0, 1], got " + format_number(sim.mm_fields_share));
     }
-    scene_.name = default_name_;
-    if (auto f = t.get("name")) scene_.name = scene_name_value(*f);
+    if (auto f = t.get("name")) {
+      scene_.name = scene_name_value(*f);
+    } else if (!valid_utf8(default_name_)) {
+      // The name goes into summary.json and run.h5, which hold UTF-8 text:
+      // a file name with other bytes failed the run's last write, after
+      // the whole simulation.
+      const Where w = t.where();
+      throw InputError(located(w.file, w.line, "simulation.name",
+                               "the scene's name defaults to the file name, which is not valid "
+                               "UTF-8; rename the file or set simulation.name"));
+    } else {
+      scene_.name = default_name_;
+    }
+  }
+
+  // Well-formed UTF-8 (the Unicode standard's table 3-7: no overlong forms,
+  // no surrogates, nothing above U+10FFFF), as the JSON writer checks it.
+  static bool valid_utf8(std::string_view s) {
+    auto byte = [&](std::size_t i) { return i < s.size() ? static_cast<unsigned char>(s[i]) : 0u; };
+    auto in = [](unsigned b, unsigned lo, unsigned hi) { return b >= lo && b <= hi; };
+    for (std::size_t i = 0; i < s.size();) {
+      const unsigned c = byte(i);
+      std::size_t n = 0;
+      unsigned lo = 0x80, hi = 0xBF;  // the range of the second byte
+      if (c < 0x80)
+        n = 1;
+      else if (in(c, 0xC2, 0xDF))
+        n = 2;
+      else if (in(c, 0xE0, 0xEF))
+        n = 3, lo = c == 0xE0 ? 0xA0 : 0x80, hi = c == 0xED ? 0x9F : 0xBF;
+      else if (in(c, 0xF0, 0xF4))
+        n = 4, lo = c == 0xF0 ? 0x90 : 0x80, hi = c == 0xF4 ? 0x8F : 0xBF;
+      else
+        return false;
+      if (n > 1 && !in(byte(i + 1), lo, hi)) return false;
+      for (std::size_t k = 2; k < n; ++k)
+        if (!in(byte(i + k), 0x80, 0xBF)) return false;
+      i += n;
+    }
+    return true;
   }
 
   // The scene name becomes a directory name under results/.
@@ -794,10 +866,10 @@ class SceneReader {
     return dim() == 2 ? (dbl ? 300 : 230) : (dbl ? 330 : 265);
   }
   void check_grid_memory(const Field& f) const {
-    const double need = grid_bytes(), have = physical_memory();
+    const double need = grid_bytes(), have = usable_memory();
     if (have > 0 && need > have)
       f.fail("the grid has " + number_text(grid_nodes()) + " nodes, at least " + gib_text(need) +
-             " for its arrays, more than this machine's memory (" + gib_text(have) +
+             " for its arrays, more than the memory this process may use (" + gib_text(have) +
              "); expected fewer or larger cells");
   }
   void check_particle_memory(const Table& t, const BodySpec& b, const Bounds& clipped) {
@@ -806,13 +878,13 @@ class SceneReader {
     particles_estimate_ +=
         body_measure(b, dim(), clipped) / cell * std::pow(double(b.particles_per_cell), dim());
     const double need = particles_estimate_ * particle_bytes() + grid_bytes(),
-                 have = physical_memory();
+                 have = usable_memory();
     if (have > 0 && need > have) {
       const auto f = t.get("particles_per_cell");
       const std::string why = "the bodies up to this one hold about " +
                               number_text(particles_estimate_) +
                               " particles, with the grid at least " + gib_text(need) +
-                              ", more than this machine's memory (" + gib_text(have) +
+                              ", more than the memory this process may use (" + gib_text(have) +
                               "); expected fewer particles per cell or smaller bodies";
       if (f) f->fail(why);
       t.need("shape").fail(why);
@@ -1155,6 +1227,46 @@ class SceneReader {
     }
   }
 
+  // In float, the products of the constants must stay normal numbers too:
+  // each constant within [1e-30, 1e30] (modulus_like) still let density,
+  // cell and thickness multiply into a particle mass of 1e60, which
+  // overflowed at the first step and was reported as an instability. The
+  // scales the kernels hold per particle (mass, momentum, stress times
+  // volume, the force it spreads over 1/h) must lie in [1e-30, 1e30]:
+  // float's normal range (1.2e-38 to 3.4e38) with 1e8 to spare for the
+  // weights, dt and the sums over a node's particles.
+  void check_float_range() const {
+    const double h = *std::min_element(scene_.grid.cell.begin(), scene_.grid.cell.begin() + dim());
+    double cell_volume = dim() == 2 ? scene_.simulation.thickness : 1.0;
+    for (int d = 0; d < dim(); ++d) cell_volume *= scene_.grid.cell[std::size_t(d)];
+    for (const BodySpec& b : scene_.bodies) {
+      const MaterialSpec& m = *find_material(b.material);
+      const double volume = cell_volume / std::pow(double(b.particles_per_cell), dim());
+      const double mass = m.density * volume;
+      const double modulus = std::max({m.E, m.EA, m.ET, m.GA});
+      double speed = 0;
+      for (int d = 0; d < dim(); ++d) speed = std::max(speed, std::abs(b.velocity[std::size_t(d)]));
+      const std::pair<const char*, double> scales[] = {
+          {"particle volume (cell volume / particles per cell)", volume},
+          {"particle mass (density x particle volume)", mass},
+          {"particle momentum (mass x velocity)", mass * speed},
+          {"stress x volume (modulus x particle volume)", modulus * volume},
+          {"nodal force (modulus x particle volume / cell size)", modulus * volume / h}};
+      for (const auto& [what, x] : scales) {
+        if (x == 0 || (x >= 1e-30 && x <= 1e30)) continue;
+        const Where& w = precision_where_;
+        throw InputError(located(
+            w.file.empty() ? src_.label() : w.file, w.line,
+            w.key.empty() ? "simulation.precision" : w.key,
+            "precision = \"float\": body " + quote(b.name) + "'s " + what + " is " +
+                format_number(x) +
+                ", outside [1e-30, 1e30], the range float holds with room for the kernels' "
+                "products and sums (its normal numbers: 1.2e-38 to 3.4e38); use precision = "
+                "\"double\", or units that bring it inside"));
+      }
+    }
+  }
+
   // ------------------------------------------------------- [[interaction]]
   void add_interaction(const Table& t) {
     t.only({"materials", "law", "friction", "Dn", "Dt", "traction_law", "Dn_compression", "normal",
@@ -1458,7 +1570,10 @@ class SceneReader {
       if (o.every > 0 && scene_.simulation.end_time / o.every > 1e12)
         f->fail("expected 0 (the last state only) or at least end_time * 1e-12 = " +
                 format_number(scene_.simulation.end_time * 1e-12) + ", got " +
-                format_number(o.every) + " (every <= dt already writes every step)");
+                format_number(o.every) +
+                " (every <= dt already writes every step; or is "
+                "simulation.end_time = " +
+                format_number(scene_.simulation.end_time) + " the typo?)");
     }
     if (auto f = t.get("fields")) {
       o.fields = output_fields(*f);
@@ -1516,6 +1631,7 @@ class SceneReader {
 
   const Source& src_;
   std::string default_name_;
+  Where precision_where_;          // simulation.precision as written (float range messages)
   double particles_estimate_ = 0;  // check_particle_memory, summed over the bodies
   std::unordered_map<std::string, std::size_t> body_index_;  // name -> scene_.bodies index
   const toml::value empty_ = toml::table{};
@@ -1687,7 +1803,29 @@ void apply_override(toml::value& root, const std::string& spec) {
   arr[*last.index] = std::move(value);
 }
 
+// toml11 3.7 takes time growing with the square of a line's length (an
+// array of 2-number points on one line: 90 kB 0.5 s, 180 kB 2.0 s, 2 MB
+// over a minute, while the same points one per line read in under a
+// second), so a longer line is refused with the way round it.
+constexpr std::size_t kLongestLine = 64 * 1024;
+void check_line_lengths(const std::string& text, const std::string& label) {
+  std::size_t start = 0;
+  for (int line = 1; start <= text.size(); ++line) {
+    std::size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    if (end - start > kLongestLine)
+      throw InputError(located(label, line, "",
+                               "line of " + std::to_string(end - start) +
+                                   " characters; expected at most " + std::to_string(kLongestLine) +
+                                   " (the TOML reader slows down with the square of a line's "
+                                   "length): write a long array over several lines, e.g. one "
+                                   "element per line"));
+    start = end + 1;
+  }
+}
+
 toml::value parse_toml(const std::string& text, const std::string& label) {
+  check_line_lengths(text, label);
   if (const int line = line_nested_too_deep(text))
     throw InputError(located(label, line, "", "TOML nesting too deep: expected " + kNestingLimit));
   std::istringstream in(text);
@@ -1720,12 +1858,32 @@ Scene parse_scene_text(const std::string& text, const std::string& file_label,
   return scene;
 }
 
+// The largest scene file read: 16 MiB, ~400 000 polygon points written one
+// per line (which toml11 reads at ~1 MB a second here).
+constexpr std::uintmax_t kLargestSceneFile = 16u << 20;
+
 Scene parse_scene_file(const std::string& path, const std::vector<std::string>& overrides) {
   // An ifstream opens a directory on Linux and reads it as empty, which
   // would be reported as a scene missing its keys.
   std::error_code ec;
-  if (std::filesystem::is_directory(path, ec))
+  const std::filesystem::file_status status = std::filesystem::status(path, ec);
+  if (std::filesystem::is_directory(status))
     throw InputError(located(path, 0, "", "is a directory; expected a scene file (TOML)"));
+  // A device or a pipe would be read until it ends: /dev/zero filled the
+  // memory, a FIFO with no writer waited for ever.
+  if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status))
+    throw InputError(located(path, 0, "",
+                             "is not a regular file (a device, pipe or socket); expected a scene "
+                             "file (TOML)"));
+  if (std::filesystem::exists(status)) {
+    const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
+    if (!ec && bytes > kLargestSceneFile)
+      throw InputError(located(path, 0, "",
+                               "is " + std::to_string(bytes) +
+                                   " bytes; expected a scene file of at "
+                                   "most " +
+                                   std::to_string(kLargestSceneFile) + " bytes"));
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(located(path, 0, "", "cannot open the scene file"));
   std::ostringstream text;

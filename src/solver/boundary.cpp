@@ -28,7 +28,7 @@ std::vector<BoundaryNodes> resolve_boundaries(const Scene& scene) {
       const double k = (spec.plane_value - g.origin[ax]) / g.cell[ax];
       plane_index = int(std::lround(k));
       if (std::abs(k - plane_index) > 1e-6 || plane_index < 0 || plane_index > g.cells[ax])
-        throw InputError(located(spec.where.file, spec.where.line, "where",
+        throw InputError(located(spec.where.file, spec.where.line, spec.where.key + ".where",
                                  "the plane must lie on a grid node plane inside the grid"));
       b.plane_axis = ax;
       b.plane_index = plane_index;
@@ -58,8 +58,8 @@ std::vector<BoundaryNodes> resolve_boundaries(const Scene& scene) {
       if (on) b.nodes.push_back(std::uint32_t(i));
     }
     if (b.nodes.empty())
-      throw InputError(
-          located(spec.where.file, spec.where.line, "where", "no grid node lies in this boundary"));
+      throw InputError(located(spec.where.file, spec.where.line, spec.where.key + ".where",
+                               "no grid node lies in this boundary"));
     out.push_back(std::move(b));
   }
   return out;

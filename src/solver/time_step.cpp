@@ -220,6 +220,15 @@ void check_step_count(const Scene& scene, double dt) {
   if (!(steps <= kMaxSteps)) bad_time_step(scene, dt, steps);
 }
 
+double end_time_tolerance(double end_time, double dt) {
+  return 1e-9 * std::min(dt, end_time);
+}
+
+long planned_steps(double end_time, double dt) {
+  if (!(end_time > 0)) return 0;
+  return std::max(1L, long(std::ceil(end_time / dt - 1e-9)));
+}
+
 double stable_time_step(const Scene& scene) {
   const double dt =
       scene.simulation.dt ? *scene.simulation.dt : scene.simulation.cfl * critical_time_step(scene);
