@@ -809,10 +809,10 @@ void run_pass(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
   // nodes may lie mostly in one thread's part (one straight interface).
   // The cursors are set before the team starts, for the team the region
   // will have, so the region has no barrier before its chunks (it had an
-  // `omp single`; the stage alone measured 22.6-23.4 us per step against
-  // 23.3-23.7 with it, docs/performance.md "The multimaterial pass on two
-  // threads from 128 nodes"). A team of another size still takes every
-  // chunk: each thread walks all the cursors.
+  // `omp single`: passes A and B each took 0.5-1.5 us more per step in the
+  // two-layer scene on two threads, docs/performance.md "The multimaterial
+  // pass on two threads from 128 nodes"). A team of another size still
+  // takes every chunk: each thread walks all the cursors.
   const bool parallel = n >= kParallelNodes;
   const std::size_t planned = parallel ? std::size_t(std::max(1, omp_get_max_threads())) : 1;
   std::vector<ChunkCursor> cursor(planned);

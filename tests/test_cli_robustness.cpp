@@ -221,3 +221,34 @@ TEST(CliRobustness, RestartWithDamagedSnapshotsIsBadInput) {
 }
 
 }  // namespace
+
+namespace {
+
+// Three messages that named the wrong thing: a --set into an array of
+// numbers was told the array held tables; a --set that put a number into
+// [[interaction]] was blamed on the file's line; an unwritable
+// output.directory from the scene had no file or line.
+TEST(CliRobustness, MessagesNameWhatWasWritten) {
+  TempDir tmp;
+  const std::string two_layer = source_dir() + "/inputs/two_layer.toml";
+  const CmdResult cell = run_mmpm_within({"check", bar_scene(), "--set", "grid.cell.x=1"}, 30);
+  EXPECT_EQ(cell.exit_code, 2) << cell.describe();
+  expect_one_line(cell, "\"cell\" is an array of values, not a table");
+  const CmdResult element = run_mmpm_within({"check", two_layer, "--set", "interaction[0]=1"}, 30);
+  EXPECT_EQ(element.exit_code, 2) << element.describe();
+  expect_one_line(element, "--set interaction[0]: key 'interaction[0]'");
+  const std::string text = read_text(bar_scene());
+  const std::string section = "[output]\n";
+  const auto at = text.find(section);
+  ASSERT_NE(at, std::string::npos);
+  const fs::path scene = tmp / "out_dir.toml";
+  write_text(scene, text.substr(0, at + section.size()) + "directory = \"/dev/null/x\"\n" +
+                        text.substr(at + section.size()));
+  const int line = line_of(read_text(scene), "directory =");
+  const CmdResult r = run_mmpm_within({"run", scene.string(), "--quiet"}, 30);
+  EXPECT_EQ(r.exit_code, 2) << r.describe();
+  expect_one_line(r, scene.string() + ":" + std::to_string(line) +
+                         ": key 'output.directory': /dev/null/x: cannot write");
+}
+
+}  // namespace

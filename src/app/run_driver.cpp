@@ -302,9 +302,16 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
 
   // Every requested output field must exist before anything is written.
   (void)sim->snapshot(scene.output.fields);
-  prepare_output_directory(dir, resume            ? "--restart"
-                                : opt.out.empty() ? "output.directory"
-                                                  : "--out");
+  // A directory the scene's key chose is blamed on that key's line.
+  const Where& key = scene.output.directory_where;
+  std::string chosen_by = "output.directory";
+  if (!key.file.empty()) {
+    chosen_by = located(key.file, key.line, key.key, "");
+    while (!chosen_by.empty() && (chosen_by.back() == ' ' || chosen_by.back() == ':'))
+      chosen_by.pop_back();
+    chosen_by += ":";
+  }
+  prepare_output_directory(dir, resume ? "--restart" : opt.out.empty() ? chosen_by : "--out");
   std::unique_ptr<io::RunWriter> writer;
   if (resume) {
     try {

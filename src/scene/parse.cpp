@@ -664,7 +664,9 @@ class SceneReader {
     if (!f) return out;
     const std::string expected = "an array of tables [[" + std::string(name) + "]]";
     for (const Field& e : f->elements(expected)) {
-      if (!e.raw().is_table()) f->wrong_type(expected);
+      // The element, not the array: a --set that put a value in the array
+      // is blamed on the --set (the element remembers where it came from).
+      if (!e.raw().is_table()) e.wrong_type("a table of [[" + std::string(name) + "]]");
       out.push_back(e.table());
     }
     return out;
@@ -1592,7 +1594,10 @@ class SceneReader {
     if (auto f = t.get("series")) o.series = f->int_at_least(1);
     if (auto f = t.get("checkpoint_minutes")) o.checkpoint_minutes = f->non_negative();
     o.directory = "results/" + scene_.name;
-    if (auto f = t.get("directory")) o.directory = f->name();
+    if (auto f = t.get("directory")) {
+      o.directory = f->name();
+      o.directory_where = f->where();
+    }
   }
 
   static std::vector<std::string> output_fields(const Field& f) {
@@ -1762,8 +1767,15 @@ toml::value& descend(toml::value& table, const PathStep& step, const std::string
       override_fail(key, quote(step.key) + " is not an array of tables");
     return arr[*step.index];
   }
-  if (v.is_array())
-    override_fail(key, quote(step.key) + " is an array of tables; name one as " + step.key + "[i]");
+  if (v.is_array()) {
+    const auto& arr = v.as_array();
+    if (!arr.empty() && arr.front().is_table())
+      override_fail(key,
+                    quote(step.key) + " is an array of tables; name one as " + step.key + "[i]");
+    override_fail(key, quote(step.key) +
+                           " is an array of values, not a table: set it whole, e.g. " + step.key +
+                           "=[...]");
+  }
   if (!v.is_table()) override_fail(key, quote(step.key) + " is not a table");
   return v;
 }

@@ -195,6 +195,7 @@ struct OutputSpec {
   int series = 100;               // steps between series rows
   double checkpoint_minutes = 0;  // wall minutes between checkpoints; 0 = none
   std::string directory;          // default results/<scene name>
+  Where directory_where;          // the key, when the scene sets it (messages)
 };
 
 struct StopSpec {
