@@ -1231,7 +1231,7 @@ class SceneReader {
 
   // In float, the products of the constants must stay normal numbers too:
   // each constant within [1e-30, 1e30] (modulus_like) still let density,
-  // cell and thickness multiply into a particle mass of 1e60, which
+  // cell and thickness multiply into a particle mass of 1e58, which
   // overflowed at the first step and was reported as an instability. The
   // scales the kernels hold per particle (mass, momentum, stress times
   // volume, the force it spreads over 1/h) must lie in [1e-30, 1e30]:
