@@ -252,3 +252,41 @@ TEST(CliRobustness, MessagesNameWhatWasWritten) {
 }
 
 }  // namespace
+
+namespace {
+
+// A swept value that makes the step unstable (or the run endless) was a
+// failed row, exit 3, after the other rows had run; `run` calls it bad
+// input. It is now refused before any row runs, naming the row.
+TEST(CliRobustness, SweepValueWithAnUnstableStepIsBadInputBeforeAnyRun) {
+  TempDir tmp;
+  const fs::path out = tmp / "sweep";
+  const CmdResult r =
+      run_mmpm_within({"sweep", bar_scene(), "--param", "simulation.dt", "--values", "1e-5,1",
+                       "--set", "simulation.end_time=0.001", "--out", out.string()},
+                      60);
+  EXPECT_EQ(r.exit_code, 2) << r.describe();
+  expect_one_line(r, "[2/2] simulation.dt=1: ");
+  EXPECT_TRUE(contains(r.err, "stability limit")) << r.err;
+  EXPECT_FALSE(fs::exists(out / "0")) << "no row may run";
+}
+
+// More jobs than cores: TBB kept one worker per core, ran fewer rows at
+// once and printed its own warning ("TBB Warning: The number of workers is
+// currently limited to 1"). The rows' lines are whole lines.
+TEST(CliRobustness, SweepWithMoreJobsThanCoresRunsThemAll) {
+  TempDir tmp;
+  const fs::path out = tmp / "sweep";
+  const CmdResult r = run_mmpm_within(
+      {"sweep", bar_scene(), "--param", "material[0].E", "--values", "1e5,2e5,3e5,4e5", "--set",
+       "simulation.end_time=0.001", "--jobs", "4", "--out", out.string()},
+      120);
+  EXPECT_EQ(r.exit_code, 0) << r.describe();
+  EXPECT_FALSE(contains(r.err, "TBB")) << r.err;
+  const auto lines = lines_of(r.err);
+  ASSERT_EQ(lines.size(), 5u) << r.err;  // four rows and "wrote"
+  for (const std::string& line : lines)
+    EXPECT_TRUE(line.starts_with("[") || line.starts_with("wrote ")) << line;
+}
+
+}  // namespace

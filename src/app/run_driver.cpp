@@ -268,17 +268,12 @@ bool still_driven(const Scene& scene, double t) {
   return false;
 }
 
-RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, const fs::path& dir,
-                 const std::vector<io::Blob>* resume) {
-  RunOutcome out;
-  out.directory = dir;
-  const auto wall0 = Clock::now();
-  if (opt.threads > 0) omp_set_num_threads(opt.threads);
-  const int threads = opt.threads > 0 ? opt.threads : omp_get_max_threads();
+}  // namespace
 
+void check_time_step(const Scene& scene, bool force) {
   const double crit = critical_time_step(scene);
   const double dt = stable_time_step(scene);
-  if (dt > crit * (1 + 1e-12) && !(opt.force || scene.simulation.force)) {
+  if (dt > crit * (1 + 1e-12) && !(force || scene.simulation.force)) {
     std::ostringstream m;
     m << "time step " << dt << " exceeds the stability limit " << crit << " (cfl " << dt / crit
       << " > 1";
@@ -288,6 +283,20 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
     fail_at_time_step_key(scene, m.str());
   }
   check_step_count(scene, dt);
+}
+
+namespace {
+
+RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, const fs::path& dir,
+                 const std::vector<io::Blob>* resume) {
+  RunOutcome out;
+  out.directory = dir;
+  const auto wall0 = Clock::now();
+  if (opt.threads > 0) omp_set_num_threads(opt.threads);
+  const int threads = opt.threads > 0 ? opt.threads : omp_get_max_threads();
+
+  check_time_step(scene, opt.force);
+  const double dt = stable_time_step(scene);
   std::unique_ptr<Simulation> sim = make_simulation(scene);
   if (!resume && opt.warnings) {
     const std::vector<std::string> warnings = start_warnings(scene, *sim, dt);

@@ -1,5 +1,6 @@
 #include "app/sweep.hpp"
 
+#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -60,23 +61,24 @@ namespace {
 // have delivered.
 class SweepWarnings {
  public:
-  SweepWarnings(std::size_t n, std::function<std::string(std::size_t)> label)
-      : rows_(n), label_(std::move(label)) {}
+  // `print`: the lock of every line the sweep writes to stderr.
+  SweepWarnings(std::size_t n, std::function<std::string(std::size_t)> label, std::mutex& print)
+      : rows_(n), label_(std::move(label)), mutex_(print) {}
 
   void deliver(std::size_t k, const std::vector<std::string>& warnings) {
     const std::lock_guard<std::mutex> lock(mutex_);
     if (!rows_[k]) rows_[k] = warnings;
     for (; next_ < rows_.size() && rows_[next_]; ++next_)
       for (const std::string& w : *rows_[next_])
-        if (printed_.insert(w).second) std::cerr << label_(next_) << w << "\n";
+        if (printed_.insert(w).second) std::cerr << label_(next_) + w + "\n" << std::flush;
   }
 
  private:
-  std::mutex mutex_;
   std::vector<std::optional<std::vector<std::string>>> rows_;
   std::size_t next_ = 0;
   std::set<std::string> printed_;
   std::function<std::string(std::size_t)> label_;
+  std::mutex& mutex_;
 };
 
 }  // namespace
@@ -91,6 +93,17 @@ int run_sweep(const SweepOptions& opt) {
     ov.push_back(opt.param + "=" + v);
     scenes.push_back(parse_scene_file(opt.scene_file, ov));
   }
+  // And every variant's time step, as `run` checks it: a value that makes
+  // the step unstable or the run endless was a failed row (exit 3) after
+  // the others had run.
+  for (std::size_t k = 0; k < n; ++k) {
+    try {
+      check_time_step(scenes[k], false);
+    } catch (const InputError& e) {
+      throw InputError("[" + std::to_string(k + 1) + "/" + std::to_string(n) + "] " + opt.param +
+                       "=" + opt.values[k] + ": " + e.what());
+    }
+  }
   const fs::path dir =
       opt.out.empty() ? fs::path("results") / (scenes.front().name + "_sweep") : opt.out;
   prepare_output_directory(dir, opt.out.empty() ? "sweep directory" : "--out");
@@ -98,13 +111,21 @@ int run_sweep(const SweepOptions& opt) {
   const int cores = int(std::max(1u, std::thread::hardware_concurrency()));
   const int threads = opt.threads > 0 ? opt.threads : std::max(1, cores / jobs);
   std::vector<RunOutcome> results(n);
+  std::mutex print_mutex;
   // Each distinct scene warning once, from the first row that gives it:
   // warnings that depend on the swept value (the cfl, the normal, the
   // particles per cell) name their row; row 0 alone would hide them.
-  SweepWarnings warnings(n, [&](std::size_t k) {
-    return "[" + std::to_string(k + 1) + "/" + std::to_string(n) + "] " + opt.param + "=" +
-           opt.values[k] + ": ";
-  });
+  SweepWarnings warnings(
+      n,
+      [&](std::size_t k) {
+        return "[" + std::to_string(k + 1) + "/" + std::to_string(n) + "] " + opt.param + "=" +
+               opt.values[k] + ": ";
+      },
+      print_mutex);
+  // TBB keeps one worker per core beyond the caller; more jobs than cores
+  // (asked for) then ran fewer at once, behind a TBB warning on stderr.
+  const tbb::global_control allow_jobs(tbb::global_control::max_allowed_parallelism,
+                                       std::size_t(jobs));
   tbb::task_arena arena(jobs);
   arena.execute([&] {
     tbb::parallel_for(std::size_t(0), n, [&](std::size_t k) {
@@ -130,9 +151,15 @@ int run_sweep(const SweepOptions& opt) {
         results[k].message = e.what();
       }
       warnings.deliver(k, {});  // a row that ended before its warnings has none
-      if (!opt.quiet)
-        std::cerr << "[" << k + 1 << "/" << n << "] " << opt.param << "=" << opt.values[k] << ": "
-                  << (results[k].exit_code == 0 ? "done" : results[k].message) << "\n";
+      if (!opt.quiet) {
+        // One write per line under the lock: rows ending together had
+        // their lines interleaved piece by piece.
+        const std::string line = "[" + std::to_string(k + 1) + "/" + std::to_string(n) + "] " +
+                                 opt.param + "=" + opt.values[k] + ": " +
+                                 (results[k].exit_code == 0 ? "done" : results[k].message) + "\n";
+        const std::lock_guard<std::mutex> lock(print_mutex);
+        std::cerr << line << std::flush;
+      }
     });
   });
   std::ostringstream csv;
