@@ -270,7 +270,7 @@ bool still_driven(const Scene& scene, double t) {
 
 }  // namespace
 
-void check_time_step(const Scene& scene, bool force) {
+double checked_time_step(const Scene& scene, bool force) {
   const double crit = critical_time_step(scene);
   const double dt = stable_time_step(scene);
   if (dt > crit * (1 + 1e-12) && !(force || scene.simulation.force)) {
@@ -283,6 +283,7 @@ void check_time_step(const Scene& scene, bool force) {
     fail_at_time_step_key(scene, m.str());
   }
   check_step_count(scene, dt);
+  return dt;
 }
 
 namespace {
@@ -295,8 +296,7 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
   if (opt.threads > 0) omp_set_num_threads(opt.threads);
   const int threads = opt.threads > 0 ? opt.threads : omp_get_max_threads();
 
-  check_time_step(scene, opt.force);
-  const double dt = stable_time_step(scene);
+  const double dt = checked_time_step(scene, opt.force);
   std::unique_ptr<Simulation> sim = make_simulation(scene);
   if (!resume && opt.warnings) {
     const std::vector<std::string> warnings = start_warnings(scene, *sim, dt);

@@ -33,9 +33,10 @@ struct RunOutcome {
   std::filesystem::path directory;
 };
 
-// The time step's checks of `run`, before anything is built: above the
-// stability limit without force, or more steps than any run (InputError).
-void check_time_step(const Scene& scene, bool force);
+// The scene's time step, checked as `run` checks it before anything is
+// built: above the stability limit without force, or more steps than any
+// run, is an InputError.
+double checked_time_step(const Scene& scene, bool force);
 
 // Runs a scene from its start, or (restart_dir non-empty) continues the run
 // whose checkpoint and resolved scene are in restart_dir.

@@ -93,15 +93,19 @@ int run_sweep(const SweepOptions& opt) {
     ov.push_back(opt.param + "=" + v);
     scenes.push_back(parse_scene_file(opt.scene_file, ov));
   }
+  // "[k/n] KEY=VALUE: ", the label of a row's lines.
+  const auto row_label = [&](std::size_t k) {
+    return "[" + std::to_string(k + 1) + "/" + std::to_string(n) + "] " + opt.param + "=" +
+           opt.values[k] + ": ";
+  };
   // And every variant's time step, as `run` checks it: a value that makes
   // the step unstable or the run endless was a failed row (exit 3) after
   // the others had run.
   for (std::size_t k = 0; k < n; ++k) {
     try {
-      check_time_step(scenes[k], false);
+      (void)checked_time_step(scenes[k], false);
     } catch (const InputError& e) {
-      throw InputError("[" + std::to_string(k + 1) + "/" + std::to_string(n) + "] " + opt.param +
-                       "=" + opt.values[k] + ": " + e.what());
+      throw InputError(row_label(k) + e.what());
     }
   }
   const fs::path dir =
@@ -115,13 +119,7 @@ int run_sweep(const SweepOptions& opt) {
   // Each distinct scene warning once, from the first row that gives it:
   // warnings that depend on the swept value (the cfl, the normal, the
   // particles per cell) name their row; row 0 alone would hide them.
-  SweepWarnings warnings(
-      n,
-      [&](std::size_t k) {
-        return "[" + std::to_string(k + 1) + "/" + std::to_string(n) + "] " + opt.param + "=" +
-               opt.values[k] + ": ";
-      },
-      print_mutex);
+  SweepWarnings warnings(n, row_label, print_mutex);
   // TBB keeps one worker per core beyond the caller; more jobs than cores
   // (asked for) then ran fewer at once, behind a TBB warning on stderr.
   const tbb::global_control allow_jobs(tbb::global_control::max_allowed_parallelism,
@@ -154,9 +152,8 @@ int run_sweep(const SweepOptions& opt) {
       if (!opt.quiet) {
         // One write per line under the lock: rows ending together had
         // their lines interleaved piece by piece.
-        const std::string line = "[" + std::to_string(k + 1) + "/" + std::to_string(n) + "] " +
-                                 opt.param + "=" + opt.values[k] + ": " +
-                                 (results[k].exit_code == 0 ? "done" : results[k].message) + "\n";
+        const std::string line =
+            row_label(k) + (results[k].exit_code == 0 ? "done" : results[k].message) + "\n";
         const std::lock_guard<std::mutex> lock(print_mutex);
         std::cerr << line << std::flush;
       }

@@ -1882,18 +1882,18 @@ Scene parse_scene_file(const std::string& path, const std::vector<std::string>& 
   if (std::filesystem::is_directory(status))
     throw InputError(located(path, 0, "", "is a directory; expected a scene file (TOML)"));
   // A device or a pipe would be read until it ends: /dev/zero filled the
-  // memory, a FIFO with no writer waited for ever.
-  if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status))
-    throw InputError(located(path, 0, "",
-                             "is not a regular file (a device, pipe or socket); expected a scene "
-                             "file (TOML)"));
+  // memory, a FIFO with no writer waited for ever. (A missing file is left
+  // to the open below.)
   if (std::filesystem::exists(status)) {
+    if (!std::filesystem::is_regular_file(status))
+      throw InputError(located(path, 0, "",
+                               "is not a regular file (a device, pipe or socket); expected a "
+                               "scene file (TOML)"));
     const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
     if (!ec && bytes > kLargestSceneFile)
       throw InputError(located(path, 0, "",
                                "is " + std::to_string(bytes) +
-                                   " bytes; expected a scene file of at "
-                                   "most " +
+                                   " bytes; expected a scene file of at most " +
                                    std::to_string(kLargestSceneFile) + " bytes"));
   }
   std::ifstream in(path, std::ios::binary);
