@@ -703,24 +703,99 @@ TEST(Cli, PositionSeparationOnABondedInterfaceWarns) {
 // series_bars with mvg: 1.2 % of the exact interface energy), so `check`
 // warns, naming the interaction's line. The shipped scene (specified
 // normal), screening (min_volume > 0) and finite stiffnesses do not.
+// (The scene's normal_vector is set back to its default with the computed
+// normals: otherwise it warns too, as a key the normal never reads.)
 TEST(Cli, ComputedNormalOnAPerfectInterfaceWarns) {
   const std::string scene = source_dir() + "/inputs/series_bars.toml";
+  const std::string unset = "interaction[0].normal_vector=[1.0, 0.0]";
   const std::string mvg = one_interaction_warning(
-      run_mmpm({"check", scene, "--set", "interaction[0].normal=\"mvg\""}), scene, "normal");
+      run_mmpm({"check", scene, "--set", "interaction[0].normal=\"mvg\"", "--set", unset}), scene,
+      "normal");
   EXPECT_TRUE(contains(mvg, "normal = \"mvg\" (mvg is the default) with Dt = \"perfect\"")) << mvg;
   EXPECT_TRUE(contains(mvg, "min_volume")) << mvg;
   const std::string avg = one_interaction_warning(
-      run_mmpm({"check", scene, "--set", "interaction[0].normal=\"avg\""}), scene, "normal");
+      run_mmpm({"check", scene, "--set", "interaction[0].normal=\"avg\"", "--set", unset}), scene,
+      "normal");
   EXPECT_TRUE(contains(avg, "normal = \"avg\" with Dt")) << avg;
-  for (const std::vector<std::string>& quiet :
-       {std::vector<std::string>{},
-        {"--set", "interaction[0].normal=\"mvg\"", "--set", "interaction[0].min_volume=0.75"},
-        {"--set", "interaction[0].normal=\"mvg\"", "--set", "interaction[0].Dt=10.0"}}) {
+  for (const std::vector<std::string>& quiet : {std::vector<std::string>{},
+                                                {"--set", "interaction[0].normal=\"mvg\"", "--set",
+                                                 unset, "--set", "interaction[0].min_volume=0.75"},
+                                                {"--set", "interaction[0].normal=\"mvg\"", "--set",
+                                                 unset, "--set", "interaction[0].Dt=10.0"}}) {
     std::vector<std::string> args{"check", scene};
     args.insert(args.end(), quiet.begin(), quiet.end());
     const CmdResult r = run_mmpm(args);
     EXPECT_EQ(r.exit_code, 0) << r.describe();
     EXPECT_EQ(r.err, "") << r.describe();
+  }
+}
+
+// Interaction keys the law or the normal never reads (scene/unused_keys.hpp):
+// two_layer's interface switched to stick keeps Dn = "perfect" and Dt = 5,
+// which then do nothing, so `check` names both, on the interaction's line;
+// a Coulomb coefficient and a normal_vector under collision's frictionless
+// law and avg normal, a center under a specified normal and Dn_compression
+// under the linear traction law warn the same way. The resolved scene
+// `check` prints warns with the same words (it writes every key; a key
+// warns only when it differs from its default), and every shipped scene,
+// and its resolved form, warns about none.
+TEST(Cli, InteractionKeysTheLawNeverReadsWarn) {
+  const std::string two_layer = source_dir() + "/inputs/two_layer.toml";
+  const std::string where =
+      two_layer + ":" + std::to_string(line_of(read_text(two_layer), "[[interaction]]")) + ":";
+  const CmdResult stick = run_mmpm({"check", two_layer, "--set", "interaction[0].law=\"stick\""});
+  ASSERT_EQ(stick.exit_code, 0) << stick.describe();
+  const auto lines = lines_of(stick.err);
+  ASSERT_EQ(lines.size(), 2u) << stick.describe();
+  EXPECT_EQ(lines[0], where +
+                          " warning: key 'interaction[0].Dn': Dn = \"perfect\" has no effect: law "
+                          "= \"stick\" does not read it (it applies to law = \"interface\")");
+  EXPECT_TRUE(contains(lines[1], where + " warning: key 'interaction[0].Dt': Dt = 5 has no effect"))
+      << lines[1];
+
+  const std::string collision = source_dir() + "/inputs/collision.toml";
+  const std::string friction = one_interaction_warning(
+      run_mmpm({"check", collision, "--set", "interaction[0].friction=0.3"}), collision,
+      "friction");
+  EXPECT_TRUE(contains(friction, "friction = 0.3 has no effect: law = \"frictionless\""))
+      << friction;
+  const std::string vector = one_interaction_warning(
+      run_mmpm({"check", collision, "--set", "interaction[0].normal_vector=[0.0, 1.0]"}), collision,
+      "normal_vector");
+  EXPECT_TRUE(contains(vector, "normal_vector = [0, 1] has no effect: normal = \"avg\"")) << vector;
+  const std::string center = one_interaction_warning(
+      run_mmpm({"check", two_layer, "--set", "interaction[0].center=[4.0, 0.0]"}), two_layer,
+      "center");
+  EXPECT_TRUE(contains(center, "center = [4, 0] has no effect: normal = \"specified\"")) << center;
+  const std::string compression = one_interaction_warning(
+      run_mmpm({"check", two_layer, "--set", "interaction[0].Dn_compression=100.0"}), two_layer,
+      "Dn_compression");
+  EXPECT_TRUE(contains(compression, "traction_law = \"linear\" uses Dn in compression"))
+      << compression;
+
+  // The resolved scene warns with the same words, at its own line.
+  TempDir tmp;
+  const fs::path resolved = tmp / "resolved.toml";
+  write_text(resolved, stick.out);
+  const CmdResult again = run_mmpm({"check", resolved.string()});
+  ASSERT_EQ(again.exit_code, 0) << again.describe();
+  const auto again_lines = lines_of(again.err);
+  ASSERT_EQ(again_lines.size(), 2u) << again.describe();
+  for (std::size_t k = 0; k < 2; ++k) {
+    const std::string tail = lines[k].substr(lines[k].find(" warning: "));
+    EXPECT_TRUE(again_lines[k].starts_with(resolved.string() + ":")) << again_lines[k];
+    EXPECT_TRUE(again_lines[k].ends_with(tail)) << again_lines[k];
+  }
+
+  for (const auto& entry : fs::directory_iterator(source_dir() + "/inputs")) {
+    if (entry.path().extension() != ".toml") continue;
+    const CmdResult r = run_mmpm({"check", entry.path().string()});
+    ASSERT_EQ(r.exit_code, 0) << r.describe();
+    EXPECT_FALSE(contains(r.err, "has no effect")) << r.describe();
+    write_text(resolved, r.out);
+    const CmdResult rr = run_mmpm({"check", resolved.string()});
+    ASSERT_EQ(rr.exit_code, 0) << entry.path() << "\n" << rr.describe();
+    EXPECT_FALSE(contains(rr.err, "has no effect")) << entry.path() << "\n" << rr.describe();
   }
 }
 
@@ -1005,7 +1080,9 @@ TEST(Cli, InterruptedSweepMarksItsRows) {
 // row 0's (which is all a sweep printed before 2026-11-29). Over the normal
 // of series_bars, two rows at a time: mvg and avg each warn (two different
 // lines, rows 1 and 2, in row order), the specified normal does not, and
-// row 4's mvg warning is row 1's, not repeated.
+// row 4's mvg warnings are row 1's, not repeated. Rows 1 and 2 each give
+// two lines: the scene's normal_vector, which a computed normal never
+// reads (scene/unused_keys.hpp), then the normal's own warning.
 TEST(Cli, SweepPrintsEachRowsOwnWarningsOnce) {
   TempDir tmp;
   const std::string scene = source_dir() + "/inputs/series_bars.toml";
@@ -1015,11 +1092,16 @@ TEST(Cli, SweepPrintsEachRowsOwnWarningsOnce) {
                 "--jobs", "2", "--quiet", "--out", (tmp / "sweep").string()});
   ASSERT_EQ(r.exit_code, 0) << r.describe();
   const auto lines = lines_of(r.err);
-  ASSERT_EQ(lines.size(), 2u) << r.describe();
-  EXPECT_EQ(lines[0].rfind("[1/4] interaction[0].normal=\"mvg\": " + scene, 0), 0u) << lines[0];
-  EXPECT_TRUE(contains(lines[0], "normal = \"mvg\"")) << lines[0];
-  EXPECT_EQ(lines[1].rfind("[2/4] interaction[0].normal=\"avg\": " + scene, 0), 0u) << lines[1];
-  EXPECT_TRUE(contains(lines[1], "normal = \"avg\"")) << lines[1];
+  ASSERT_EQ(lines.size(), 4u) << r.describe();
+  for (std::size_t k = 0; k < 4; ++k) {
+    const std::string normal = k < 2 ? "mvg" : "avg";
+    const std::string label =
+        "[" + std::to_string(k / 2 + 1) + "/4] interaction[0].normal=\"" + normal + "\": " + scene;
+    EXPECT_EQ(lines[k].rfind(label, 0), 0u) << lines[k];
+    EXPECT_TRUE(contains(lines[k], "normal = \"" + normal + "\"")) << lines[k];
+    const std::string key = k % 2 == 0 ? "normal_vector" : "normal";
+    EXPECT_TRUE(contains(lines[k], "key 'interaction[0]." + key + "'")) << lines[k];
+  }
 }
 
 TEST(Cli, SweepWritesTableAndOneSummaryPerValue) {

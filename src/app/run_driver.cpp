@@ -279,7 +279,8 @@ double checked_time_step(const Scene& scene, bool force) {
       << " > 1";
     if (crit == damping_time_step(scene))
       m << "; the limit is 2 / grid.damping, of the damping " << scene.grid.damping;
-    m << "); lower it, or run with --force";
+    // `sweep` has no --force flag: the scene key serves both commands.
+    m << "); lower it, or run with --force (or simulation.force = true)";
     fail_at_time_step_key(scene, m.str());
   }
   check_step_count(scene, dt);

@@ -5,6 +5,7 @@
 
 #include "scene/format.hpp"
 #include "scene/interaction_warning.hpp"
+#include "scene/unused_keys.hpp"
 #include "solver/contact_gap.hpp"
 #include "solver/simulation.hpp"
 
@@ -67,7 +68,7 @@ std::vector<std::string> computed_normal_warnings(const Scene& scene) {
 }  // namespace
 
 std::vector<std::string> start_warnings(const Scene& scene, const Simulation& sim, double dt) {
-  std::vector<std::string> out;
+  std::vector<std::string> out = unused_interaction_key_warnings(scene);
   if (std::string w = usl_time_step_warning(scene, dt); !w.empty()) out.push_back(std::move(w));
   for (std::string& w : stiff_interface_warnings(scene, dt)) out.push_back(std::move(w));
   for (std::string& w : open_contact_warnings(scene, sim)) out.push_back(std::move(w));

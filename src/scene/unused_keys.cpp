@@ -1,0 +1,75 @@
+#include "scene/unused_keys.hpp"
+
+#include <cmath>
+
+#include "scene/format.hpp"
+#include "scene/interaction_warning.hpp"
+
+namespace mmpm {
+
+namespace {
+
+std::string stiffness_text(double d) {
+  return std::isinf(d) ? "\"perfect\"" : format_number(d);
+}
+
+std::string vector_text(const Vec3& v, int dim) {
+  std::string s = "[";
+  for (int k = 0; k < dim; ++k) {
+    if (k > 0) s += ", ";
+    s += format_number(v[static_cast<std::size_t>(k)]);
+  }
+  return s + "]";
+}
+
+}  // namespace
+
+std::vector<std::string> unused_interaction_key_warnings(const Scene& scene) {
+  std::vector<std::string> out;
+  const InteractionSpec defaults;
+  const int dim = scene.simulation.dimension;
+  for (std::size_t k = 0; k < scene.interactions.size(); ++k) {
+    const InteractionSpec& it = scene.interactions[k];
+    const std::string law = "law = \"" + std::string(scene_name(it.law)) + "\"";
+    const auto warn = [&](const char* key, const std::string& value, const std::string& why) {
+      out.push_back(interaction_warning(scene, k, key) + key + " = " + value +
+                    " has no effect: " + why);
+    };
+    // The interface's own keys (ALGORITHM §4: the traction law, its force
+    // limit and integration, the contact area) are read by law = "interface" only.
+    if (it.law != Law::interface) {
+      const std::string why = law + " does not read it (it applies to law = \"interface\")";
+      if (it.Dn != defaults.Dn) warn("Dn", stiffness_text(it.Dn), why);
+      if (it.Dt != defaults.Dt) warn("Dt", stiffness_text(it.Dt), why);
+      if (it.traction_law != defaults.traction_law)
+        warn("traction_law", "\"" + std::string(scene_name(it.traction_law)) + "\"", why);
+      if (it.Dn_compression != defaults.Dn_compression)
+        warn("Dn_compression", stiffness_text(it.Dn_compression), why);
+      if (it.force_limit != defaults.force_limit) warn("force_limit", "false", why);
+      if (it.integration != defaults.integration)
+        warn("integration", "\"" + std::string(scene_name(it.integration)) + "\"", why);
+    } else if (it.traction_law == TractionLaw::linear &&
+               it.Dn_compression != defaults.Dn_compression) {
+      warn("Dn_compression", stiffness_text(it.Dn_compression),
+           "traction_law = \"linear\" uses Dn in compression too (Dn_compression applies to "
+           "traction_law = \"bilinear\")");
+    }
+    // Coulomb's coefficient (P-16) is read by law = "friction" only.
+    if (it.law != Law::friction && it.friction != defaults.friction) {
+      warn("friction", format_number(it.friction),
+           law + " does not read it (it applies to law = \"friction\")");
+    }
+    const std::string normal = "normal = \"" + std::string(scene_name(it.normal)) + "\"";
+    if (it.normal != NormalMethod::specified && it.normal_vector != defaults.normal_vector) {
+      warn("normal_vector", vector_text(it.normal_vector, dim),
+           normal + " computes its own normal (normal_vector applies to normal = \"specified\")");
+    }
+    if (it.normal != NormalMethod::radial && it.center != defaults.center) {
+      warn("center", vector_text(it.center, dim),
+           normal + " does not read it (center applies to normal = \"radial\")");
+    }
+  }
+  return out;
+}
+
+}  // namespace mmpm
