@@ -35,8 +35,9 @@ std::vector<std::string> unused_interaction_key_warnings(const Scene& scene) {
       out.push_back(interaction_warning(scene, k, key) + key + " = " + value +
                     " has no effect: " + why);
     };
-    // The interface's own keys (ALGORITHM §4: the traction law, its force
-    // limit and integration, the contact area) are read by law = "interface" only.
+    // The interface's own keys (ALGORITHM §4: the stiffnesses, the traction
+    // law, its force limit and integration) are read by law = "interface"
+    // only; `area` outside that law is already an error (parse.cpp).
     if (it.law != Law::interface) {
       const std::string why = law + " does not read it (it applies to law = \"interface\")";
       if (it.Dn != defaults.Dn) warn("Dn", stiffness_text(it.Dn), why);
