@@ -269,16 +269,17 @@ TEST(CliRobustness, SweepValueWithAnUnstableStepIsBadInputBeforeAnyRun) {
   expect_one_line(r, "[2/2] simulation.dt=1: ");
   EXPECT_TRUE(contains(r.err, "stability limit")) << r.err;
   EXPECT_FALSE(fs::exists(out / "0")) << "no row may run";
-  // The remedy it names works in a sweep (which has no --force flag): the
-  // rows run, and the unstable one fails as a run (exit 3), not as input.
+  // The remedy it names works in a sweep (which has no --force flag): both
+  // rows run. The forced row's one step is shortened to end_time (0.001,
+  // 10x the limit), which stays inside the energy check: exit 0.
   EXPECT_TRUE(contains(r.err, "or simulation.force = true")) << r.err;
   const CmdResult forced =
       run_mmpm_within({"sweep", bar_scene(), "--param", "simulation.dt", "--values", "1e-5,1",
                        "--set", "simulation.end_time=0.001", "--set", "simulation.force=true",
                        "--out", (tmp / "forced").string()},
                       60);
-  EXPECT_NE(forced.exit_code, 2) << forced.describe();
-  EXPECT_TRUE(fs::exists(tmp / "forced" / "0")) << forced.describe();
+  EXPECT_EQ(forced.exit_code, 0) << forced.describe();
+  EXPECT_TRUE(fs::exists(tmp / "forced" / "1" / "summary.json")) << forced.describe();
 }
 
 // More jobs than cores: TBB kept one worker per core, ran fewer rows at
