@@ -35,6 +35,13 @@ std::string format_toml_float(double x) {
   return s;
 }
 
+std::string format_vector(const Vec3& v, int dim) {
+  std::string s = "[";
+  for (int k = 0; k < dim; ++k)
+    s += (k > 0 ? ", " : "") + format_number(v[static_cast<std::size_t>(k)]);
+  return s + "]";
+}
+
 namespace {
 
 std::string quoted(std::string_view s) {

@@ -137,6 +137,9 @@ std::string format_number(double x);
 // format_number() plus ".0" when needed so TOML reads a float, not an integer.
 std::string format_toml_float(double x);
 
+// "[x, y]" or "[x, y, z]": the first `dim` entries by format_number(), for messages.
+std::string format_vector(const Vec3& v, int dim);
+
 // The resolved scene as TOML: every section and key, defaults included.
 std::string format_scene(const Scene& scene);
 

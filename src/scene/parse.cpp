@@ -124,13 +124,6 @@ Keys names_of(const std::array<EnumName<E>, N>& names) {
   return out;
 }
 
-std::string vec_text(const Vec3& v, int dim) {
-  std::string s = "[";
-  for (int k = 0; k < dim; ++k)
-    s += (k > 0 ? ", " : "") + format_number(v[static_cast<std::size_t>(k)]);
-  return s + "]";
-}
-
 std::string type_name(const toml::value& v) {
   switch (v.type()) {
     case toml::value_t::boolean:
@@ -824,7 +817,7 @@ class SceneReader {
     g.cell = cell.vec(dim(), {1, 1, 1});
     for (int k = 0; k < dim(); ++k) {
       if (!(g.cell[static_cast<std::size_t>(k)] > 0)) {
-        cell.fail("expected every cell size > 0, got " + vec_text(g.cell, dim()));
+        cell.fail("expected every cell size > 0, got " + format_vector(g.cell, dim()));
       }
     }
     read_cells(t.need("cells"));
@@ -1151,8 +1144,8 @@ class SceneReader {
     const Vec3 hi = max.vec(dim());
     for (std::size_t k = 0; k < static_cast<std::size_t>(dim()); ++k) {
       if (!(hi[k] > lo[k])) {
-        max.fail("expected max > min in every direction, got min " + vec_text(lo, dim()) +
-                 " and max " + vec_text(hi, dim()));
+        max.fail("expected max > min in every direction, got min " + format_vector(lo, dim()) +
+                 " and max " + format_vector(hi, dim()));
       }
     }
     return {lo, hi};

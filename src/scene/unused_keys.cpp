@@ -13,13 +13,10 @@ std::string stiffness_text(double d) {
   return std::isinf(d) ? "\"perfect\"" : format_number(d);
 }
 
-std::string vector_text(const Vec3& v, int dim) {
-  std::string s = "[";
-  for (int k = 0; k < dim; ++k) {
-    if (k > 0) s += ", ";
-    s += format_number(v[static_cast<std::size_t>(k)]);
-  }
-  return s + "]";
+// The scene-file word of an enum value, in quotes: "\"stick\"".
+template <class E>
+std::string quoted_word(E value) {
+  return "\"" + std::string(scene_name(value)) + "\"";
 }
 
 }  // namespace
@@ -30,7 +27,7 @@ std::vector<std::string> unused_interaction_key_warnings(const Scene& scene) {
   const int dim = scene.simulation.dimension;
   for (std::size_t k = 0; k < scene.interactions.size(); ++k) {
     const InteractionSpec& it = scene.interactions[k];
-    const std::string law = "law = \"" + std::string(scene_name(it.law)) + "\"";
+    const std::string law = "law = " + quoted_word(it.law);
     const auto warn = [&](const char* key, const std::string& value, const std::string& why) {
       out.push_back(interaction_warning(scene, k, key) + key + " = " + value +
                     " has no effect: " + why);
@@ -43,12 +40,12 @@ std::vector<std::string> unused_interaction_key_warnings(const Scene& scene) {
       if (it.Dn != defaults.Dn) warn("Dn", stiffness_text(it.Dn), why);
       if (it.Dt != defaults.Dt) warn("Dt", stiffness_text(it.Dt), why);
       if (it.traction_law != defaults.traction_law)
-        warn("traction_law", "\"" + std::string(scene_name(it.traction_law)) + "\"", why);
+        warn("traction_law", quoted_word(it.traction_law), why);
       if (it.Dn_compression != defaults.Dn_compression)
         warn("Dn_compression", stiffness_text(it.Dn_compression), why);
       if (it.force_limit != defaults.force_limit) warn("force_limit", "false", why);
       if (it.integration != defaults.integration)
-        warn("integration", "\"" + std::string(scene_name(it.integration)) + "\"", why);
+        warn("integration", quoted_word(it.integration), why);
     } else if (it.traction_law == TractionLaw::linear &&
                it.Dn_compression != defaults.Dn_compression) {
       warn("Dn_compression", stiffness_text(it.Dn_compression),
@@ -60,13 +57,13 @@ std::vector<std::string> unused_interaction_key_warnings(const Scene& scene) {
       warn("friction", format_number(it.friction),
            law + " does not read it (it applies to law = \"friction\")");
     }
-    const std::string normal = "normal = \"" + std::string(scene_name(it.normal)) + "\"";
+    const std::string normal = "normal = " + quoted_word(it.normal);
     if (it.normal != NormalMethod::specified && it.normal_vector != defaults.normal_vector) {
-      warn("normal_vector", vector_text(it.normal_vector, dim),
+      warn("normal_vector", format_vector(it.normal_vector, dim),
            normal + " computes its own normal (normal_vector applies to normal = \"specified\")");
     }
     if (it.normal != NormalMethod::radial && it.center != defaults.center) {
-      warn("center", vector_text(it.center, dim),
+      warn("center", format_vector(it.center, dim),
            normal + " does not read it (center applies to normal = \"radial\")");
     }
   }
