@@ -181,11 +181,12 @@ void fields_present(const Real* m, std::size_t nodes, int fields, Real threshold
 }  // namespace mm_detail
 
 // Nodes where at least two fields have m > mass_threshold, in ascending order.
-// Blocks of nodes are counted and listed by the thread that owns them
-// (kernels/node_ownership.hpp); the list does not depend on who did which.
-// With `mixed` (kernels/mixed_tiles.hpp) only the nodes of tiles next to
-// particles of two or more fields are read: the same list, as no other node
-// can hold two fields' mass.
+// Blocks of nodes are searched by the thread that owns them
+// (kernels/node_ownership.hpp), each block's nodes listed into a slot of its
+// own; the slots are then joined in block order, so the list does not depend
+// on who did which. With `mixed` (kernels/mixed_tiles.hpp) only the nodes of
+// tiles next to particles of two or more fields are read: the same list, as
+// no other node can hold two fields' mass.
 template <int D, class Real>
 void find_multimaterial_nodes(const GridView<D, Real>& grid, Real mass_threshold,
                               std::vector<std::uint32_t>& list, const NodeOwnership& own = {},
@@ -200,14 +201,19 @@ void find_multimaterial_nodes(const GridView<D, Real>& grid, Real mass_threshold
   }
   const std::size_t blocks = (nodes + kFindBlock - 1) / kFindBlock;
   std::vector<std::size_t> offset(blocks + 1, 0);
-  // The counts of the first pass, kept for the listing (not recomputed).
-  const std::unique_ptr<unsigned char[]> present_all(new unsigned char[blocks * kFindBlock]);
+  // Block b's nodes, listed at slot b * kFindBlock; only the listed entries
+  // are written. Why one walk: listing in a second walk over the candidate
+  // runs (from the counts of the first) cost a third of the search where an
+  // interface crosses the rows, one short run per row (two-layer scene:
+  // 255 runs of 48 nodes), docs/multimaterial.md "Finding the
+  // multimaterial nodes".
+  const std::unique_ptr<std::uint32_t[]> slots(new std::uint32_t[blocks * kFindBlock]);
 
 #pragma omp parallel if (nodes >= kParallelMin)
   {
     const auto [b0, b1] = own.chunks(nodes, kFindBlock, std::size_t(omp_get_num_threads()),
                                      std::size_t(omp_get_thread_num()));
-    std::uint32_t found[kFindBlock];
+    unsigned char present[kFindBlock];
     auto block_count = [&](std::size_t b) {
       return std::min(nodes, (b + 1) * kFindBlock) - b * kFindBlock;
     };
@@ -220,26 +226,10 @@ void find_multimaterial_nodes(const GridView<D, Real>& grid, Real mass_threshold
         body(b * kFindBlock, block_count(b));
     };
     for (std::size_t b = b0; b < b1; ++b) {
-      std::size_t multi = 0;
+      std::uint32_t* found = slots.get() + b * kFindBlock;
+      std::size_t out = 0;  // a local: `found` entries of this block
       for_candidates(b, [&](std::size_t first, std::size_t count) {
-        unsigned char* present = present_all.get() + first;
         mm_detail::fields_present(grid.m, nodes, F, mass_threshold, first, count, present);
-        unsigned run_multi = 0;  // a local: `multi` is a captured reference
-        for (std::size_t i = 0; i < count; ++i) run_multi += present[i] >= 2;
-        multi += run_multi;
-      });
-      offset[b + 1] = multi;
-    }
-#pragma omp barrier
-#pragma omp single
-    {
-      for (std::size_t b = 0; b < blocks; ++b) offset[b + 1] += offset[b];
-      list.resize(offset[blocks]);
-    }
-    for (std::size_t b = b0; b < b1; ++b) {
-      std::size_t out = 0;
-      for_candidates(b, [&](std::size_t first, std::size_t count) {
-        const unsigned char* present = present_all.get() + first;
         for (std::size_t g = 0; g < count; g += kFindGroup) {
           const std::size_t n = std::min(kFindGroup, count - g);
           if (n == kFindGroup && !mm_detail::any_two_or_more(present + g)) continue;
@@ -248,7 +238,18 @@ void find_multimaterial_nodes(const GridView<D, Real>& grid, Real mass_threshold
             found[out++] = std::uint32_t(first + g + std::size_t(std::countr_zero(bits)));
         }
       });
-      std::copy(found, found + out, list.begin() + std::ptrdiff_t(offset[b]));
+      offset[b + 1] = out;
+    }
+#pragma omp barrier
+#pragma omp single
+    {
+      for (std::size_t b = 0; b < blocks; ++b) offset[b + 1] += offset[b];
+      list.resize(offset[blocks]);
+    }
+    for (std::size_t b = b0; b < b1; ++b) {
+      const std::uint32_t* found = slots.get() + b * kFindBlock;
+      std::copy(found, found + (offset[b + 1] - offset[b]),
+                list.begin() + std::ptrdiff_t(offset[b]));
     }
   }
 }
