@@ -52,6 +52,7 @@ void register_step();
 void register_mm_scene();
 void register_scaling();
 void register_step_pair();
+void register_team();
 void register_step_ab();
 void register_seed();
 

@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   mmpm::bench::register_sort();
   mmpm::bench::register_step();
   mmpm::bench::register_step_pair();
+  mmpm::bench::register_team();
   mmpm::bench::register_step_ab();
   mmpm::bench::register_mm_scene();
   mmpm::bench::register_scaling();

@@ -253,6 +253,14 @@ StepCase shared_case(const std::string& scene) {
   // of the nodes are empty, as around a body with room to move.
   if (scene == "2d_linear_room") return {scene, linear_block_scene(250), {"grid.cells=[504, 504]"}};
   if (scene == "2d_linear_1e6") return {scene, linear_block_scene(500), {}};
+  // The small scenes researchers run most (the shipped inputs/ scenes hold
+  // 256 to 10 240 particles): 2d_linear_1mat's block with 10^4 particles,
+  // and the two-layer scene on cells 5x wider (10^4 particles).
+  if (scene == "2d_linear_10k") return {scene, linear_block_scene(50), {}};
+  if (scene == "2d_gimp_interface_10k")
+    return {scene,
+            two_layer(true, true),
+            {"grid.origin=[-3.0, -3.0]", "grid.cell=[5.0, 5.0]", "grid.cells=[52, 52]"}};
   throw std::invalid_argument("no whole-step scene named " + scene);
 }
 

@@ -104,8 +104,8 @@ void set_paired_counters(benchmark::State& state, const std::vector<BlockTimes>&
 }
 
 void register_step_pair() {
-  for (const char* scene :
-       {"2d_linear_1mat", "2d_gimp_interface", "2d_gimp_inclusions", "3d_gimp_1mat"}) {
+  for (const char* scene : {"2d_linear_1mat", "2d_gimp_interface", "2d_gimp_inclusions",
+                            "3d_gimp_1mat", "2d_linear_10k", "2d_gimp_interface_10k"}) {
     const std::string name = std::string("step_pair/scene:") + scene;
     auto* b = benchmark::RegisterBenchmark(
         name.c_str(), [scene](benchmark::State& st) { bm_step_pair(st, scene); });

@@ -361,9 +361,8 @@ template <class T>
 inline void permute_in_place(T* __restrict a, T* __restrict scratch,
                              const std::uint32_t* __restrict perm, std::size_t n,
                              const TileSchedule* sorted = nullptr) {
-#pragma omp parallel if (n >= kParallelMin)
-  {
-    const auto threads = std::size_t(omp_get_num_threads()), me = std::size_t(omp_get_thread_num());
+  team_run(n >= kParallelMin, [&] {
+    const auto threads = std::size_t(team_size()), me = std::size_t(team_rank());
     TileSchedule::Ranges mine;
     if (sorted) {
       mine = sorted->thread_ranges(threads, me);
@@ -374,12 +373,12 @@ inline void permute_in_place(T* __restrict a, T* __restrict scratch,
     for (std::size_t r = 0; r < mine.count; ++r)
       for (std::size_t i = mine.range[r].first; i < mine.range[r].second; ++i)
         scratch[i] = a[perm[i]];
-#pragma omp barrier
+    team_barrier();
     for (std::size_t r = 0; r < mine.count; ++r) {
       const auto [b, e] = mine.range[r];
       if (e > b) std::memcpy(a + b, scratch + b, (e - b) * sizeof(T));
     }
-  }
+  });
 }
 
 }  // namespace mmpm

@@ -236,10 +236,11 @@ double grid_update(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
     // nodes split at 11 353, thread 0 took 12 288 and ran ~1.5x longer than
     // thread 1 (docs/performance.md "The grid stage on two threads"). A
     // node's result does not depend on the range it is in.
-#pragma omp parallel if (G.nodes * std::size_t(G.fields) >= kParallelMin)
-    for_own_field_nodes(own, G.nodes, G.fields, [&](int f, std::size_t b, std::size_t e) {
-      std::array<double, 1> none{};
-      update_then_hook(f, b, e, none);
+    team_run(G.nodes * std::size_t(G.fields) >= kParallelMin, [&] {
+      for_own_field_nodes(own, G.nodes, G.fields, [&](int f, std::size_t b, std::size_t e) {
+        std::array<double, 1> none{};
+        update_then_hook(f, b, e, none);
+      });
     });
     return 0;
   }
@@ -259,8 +260,9 @@ namespace detail {
 template <bool CompleteDvel, int D, class Real, class After>
 void node_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V, Real thr,
                      const LightNodes<D, Real>& ln, const NodeOwnership& own, After& after) {
-#pragma omp parallel if (G.nodes * std::size_t(G.fields) >= kParallelMin)
-  for_own_field_nodes(own, G.nodes, G.fields, [&](int f, std::size_t first, std::size_t last) {
+  // The ranges' loop is a function of its own, as it was the body of an
+  // OpenMP region (its restrict locals keep it vectorised).
+  const auto ranges = [&](int f, std::size_t first, std::size_t last) {
     const std::size_t o = std::size_t(f) * G.nodes;
     // Locals, not reads through `ln` in the loop: the stores to vel_ and
     // dv_ could alias them, and the loop then stayed scalar
@@ -296,7 +298,9 @@ void node_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
       }
     }
     after(f, first, last);
-  });
+  };
+  team_run(G.nodes * std::size_t(G.fields) >= kParallelMin,
+           [&] { for_own_field_nodes(own, G.nodes, G.fields, ranges); });
 }
 
 }  // namespace detail

@@ -209,10 +209,9 @@ void find_multimaterial_nodes(const GridView<D, Real>& grid, Real mass_threshold
   // multimaterial nodes".
   const std::unique_ptr<std::uint32_t[]> slots(new std::uint32_t[blocks * kFindBlock]);
 
-#pragma omp parallel if (nodes >= kParallelMin)
-  {
-    const auto [b0, b1] = own.chunks(nodes, kFindBlock, std::size_t(omp_get_num_threads()),
-                                     std::size_t(omp_get_thread_num()));
+  team_run(nodes >= kParallelMin, [&] {
+    const auto [b0, b1] =
+        own.chunks(nodes, kFindBlock, std::size_t(team_size()), std::size_t(team_rank()));
     unsigned char present[kFindBlock];
     auto block_count = [&](std::size_t b) {
       return std::min(nodes, (b + 1) * kFindBlock) - b * kFindBlock;
@@ -240,18 +239,18 @@ void find_multimaterial_nodes(const GridView<D, Real>& grid, Real mass_threshold
       });
       offset[b + 1] = out;
     }
-#pragma omp barrier
-#pragma omp single
-    {
+    team_barrier();
+    if (team_rank() == 0) {
       for (std::size_t b = 0; b < blocks; ++b) offset[b + 1] += offset[b];
       list.resize(offset[blocks]);
     }
+    team_barrier();
     for (std::size_t b = b0; b < b1; ++b) {
       const std::uint32_t* found = slots.get() + b * kFindBlock;
       std::copy(found, found + (offset[b + 1] - offset[b]),
                 list.begin() + std::ptrdiff_t(offset[b]));
     }
-  }
+  });
 }
 
 namespace mm_detail {
@@ -831,9 +830,8 @@ void run_pass(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
   }
 
   static_assert(kParallelNodes >= 2 * kChunk, "a team needs two chunks to share");
-#pragma omp parallel if (parallel)
-  {
-    const std::size_t me = std::size_t(omp_get_thread_num());
+  team_run(parallel, [&] {
+    const std::size_t me = std::size_t(team_rank());
     NodeFields<D, Real> nf;
     const auto batch = std::make_unique<PairBatch<D, Real>>();
     // A chunk's statistics are summed in the thread's own copy and stored
@@ -856,7 +854,7 @@ void run_pass(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
         partial[c] = local;
       }
     }
-  }
+  });
 
   for (std::size_t c = 0; c < chunks; ++c) {  // serial, in chunk order
     stats.interface_energy += partial[c].energy;

@@ -66,7 +66,7 @@ struct NodeOwnership {
   }
   // The calling thread's nodes inside a parallel region.
   std::pair<std::size_t, std::size_t> mine(std::size_t nodes) const {
-    return range(nodes, std::size_t(omp_get_num_threads()), std::size_t(omp_get_thread_num()));
+    return range(nodes, std::size_t(team_size()), std::size_t(team_rank()));
   }
 };
 
@@ -163,10 +163,11 @@ struct NoNodeHook {
 template <class Real, std::size_t N>
 void zero_owned(const NodeOwnership& own, std::size_t nodes, int fields,
                 const std::array<Real*, N>& arrays) {
-#pragma omp parallel if (nodes * std::size_t(fields) >= kParallelMin)
-  for_own_nodes(own, nodes, fields, [&](std::size_t b, std::size_t e) {
-    for (Real* a : arrays)
-      if (a) std::fill(a + b, a + e, Real(0));
+  team_run(nodes * std::size_t(fields) >= kParallelMin, [&] {
+    for_own_nodes(own, nodes, fields, [&](std::size_t b, std::size_t e) {
+      for (Real* a : arrays)
+        if (a) std::fill(a + b, a + e, Real(0));
+    });
   });
 }
 
@@ -179,10 +180,9 @@ std::vector<std::array<double, K>> owned_field_sums(const NodeOwnership& own, st
                                                     int fields, Body&& body) {
   const std::size_t chunks = chunk_count(nodes);
   std::vector<std::array<double, K>> partial(chunks * std::size_t(fields));
-#pragma omp parallel if (nodes * std::size_t(fields) >= kParallelMin)
-  {
-    const auto [c0, c1] = own.chunks(nodes, kReduceChunk, std::size_t(omp_get_num_threads()),
-                                     std::size_t(omp_get_thread_num()));
+  team_run(nodes * std::size_t(fields) >= kParallelMin, [&] {
+    const auto [c0, c1] =
+        own.chunks(nodes, kReduceChunk, std::size_t(team_size()), std::size_t(team_rank()));
     for (int f = 0; f < fields; ++f)
       for (std::size_t c = c0; c < c1; ++c) {
         std::array<double, K> acc{};
@@ -196,7 +196,7 @@ std::vector<std::array<double, K>> owned_field_sums(const NodeOwnership& own, st
           body(f, b, e, acc);
         partial[std::size_t(f) * chunks + c] = acc;
       }
-  }
+  });
   std::vector<std::array<double, K>> total(std::size_t(fields), std::array<double, K>{});
   for (int f = 0; f < fields; ++f)
     for (std::size_t c = 0; c < chunks; ++c)

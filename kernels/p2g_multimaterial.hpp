@@ -16,6 +16,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -66,8 +67,7 @@ std::size_t p2g_multimaterial_fields(const ParticleView<D, Real>& P, const GridV
   // Zero the boxes the scatter adds into: all colors first (boxes of tiles
   // of different colors overlap); tiles of one color have disjoint boxes.
   for (const auto& list : reach_tiles.tiles) {
-#pragma omp parallel for schedule(static) if (parallel)
-    for (std::size_t k = 0; k < list.size(); ++k) {
+    team_for(parallel, list.size(), [&](std::size_t k) {
       const NodeBox box =
           tile_node_box(layout, layout.tile_of_slot(list[k]), G.nodes_per_dim, reach);
       zero_node_box<D>(G.vol, G.nodes, G.fields, G.nodes_per_dim, box);
@@ -75,21 +75,20 @@ std::size_t p2g_multimaterial_fields(const ParticleView<D, Real>& P, const GridV
         zero_node_box<D>(G.mx[d], G.nodes, G.fields, G.nodes_per_dim, box);
         if (with_gradient) zero_node_box<D>(G.g[d], G.nodes, G.fields, G.nodes_per_dim, box);
       }
-    }
+    });
   }
-  std::size_t bad = SIZE_MAX;
+  std::atomic<std::size_t> bad{SIZE_MAX};
   for (const auto& list : reach_tiles.tiles) {
-#pragma omp parallel for schedule(static) reduction(min : bad) if (parallel)
-    for (std::size_t k = 0; k < list.size(); ++k) {
+    team_for(parallel, list.size(), [&](std::size_t k) {
       const std::size_t b = schedule.begin[list[k]], e = schedule.begin[list[k] + 1];
       const std::size_t r =
           with_gradient ? p2g_range<D, Shape, Real, kMultimaterial | kDomainGradient, true, false>(
                               P, G, opt, b, e)
                         : p2g_range<D, Shape, Real, kMultimaterial, true, false>(P, G, opt, b, e);
-      if (r != e) bad = std::min(bad, r);
-    }
+      if (r != e) offer_min(bad, r);
+    });
   }
-  return bad;
+  return bad.load();
 }
 
 }  // namespace mmpm

@@ -9,11 +9,13 @@
 #include <utility>
 #include <vector>
 
+#include "kernels/team.hpp"
+
 namespace mmpm {
 
 inline constexpr std::size_t kReduceChunk = 4096;
 // Loops shorter than this run on one thread: waking a team costs more than
-// the work (a few microseconds per parallel region).
+// the work (about a microsecond per region, kernels/team.hpp).
 inline constexpr std::size_t kParallelMin = 8192;
 
 // The calling thread's contiguous block [first, last) of n items, the
@@ -34,12 +36,11 @@ template <int K, class Body>
 std::array<double, K> deterministic_sum(std::size_t n, Body&& body) {
   const std::size_t chunks = chunk_count(n);
   std::vector<std::array<double, K>> partial(chunks);
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (std::size_t c = 0; c < chunks; ++c) {
+  team_for(n >= kParallelMin, chunks, [&](std::size_t c) {
     std::array<double, K> acc{};
     body(c * kReduceChunk, std::min(n, (c + 1) * kReduceChunk), acc);
     partial[c] = acc;
-  }
+  });
   std::array<double, K> total{};
   for (const auto& a : partial)
     for (int k = 0; k < K; ++k) total[k] += a[k];

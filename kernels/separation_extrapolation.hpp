@@ -40,6 +40,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -227,33 +228,32 @@ std::size_t extrapolate_separation(const ParticleView<D, Real>& P, const GridVie
   // moments zeroed: nothing reads the moments anywhere else.
   if (listed.size() != G.nodes) listed.assign(G.nodes, 0);
   for (const std::uint32_t n : nodes) listed[n] = 1;
-#pragma omp parallel for schedule(static) if (parallel)
-  for (std::size_t k = 0; k < nodes.size(); ++k)
+  team_for(parallel, nodes.size(), [&](std::size_t k) {
     for (int f = 0; f < G.fields; ++f) {
       const std::size_t i = G.at(f, nodes[k]);
       for (int a = 0; a < D; ++a) M.r[a][i] = Real(0);
       for (int a = 0; a < kSym; ++a) M.rr[std::size_t(a)][i] = Real(0);
       for (int a = 0; a < D * D; ++a) M.ur[std::size_t(a)][i] = Real(0);
     }
-  std::size_t bad = SIZE_MAX;
+  });
+  std::atomic<std::size_t> first_bad{SIZE_MAX};
   for (const auto& list : reach_tiles.tiles) {
-#pragma omp parallel for schedule(static) reduction(min : bad) if (parallel)
-    for (std::size_t k = 0; k < list.size(); ++k) {
+    team_for(parallel, list.size(), [&](std::size_t k) {
       const std::size_t b = schedule.begin[list[k]], e = schedule.begin[list[k] + 1];
-      bad = std::min(
-          bad, separation_detail::scatter_moments<D, Shape, Real>(P, G, M, listed.data(), b, e));
-    }
+      offer_min(first_bad,
+                separation_detail::scatter_moments<D, Shape, Real>(P, G, M, listed.data(), b, e));
+    });
   }
   for (const std::uint32_t n : nodes) listed[n] = 0;
-  if (bad != SIZE_MAX) return bad;
-#pragma omp parallel for schedule(static) if (parallel)
-  for (std::size_t k = 0; k < nodes.size(); ++k)
+  if (const std::size_t bad = first_bad.load(); bad != SIZE_MAX) return bad;
+  team_for(parallel, nodes.size(), [&](std::size_t k) {
     for (int f = 0; f < G.fields; ++f) {
       if (rigid && rigid[f]) continue;
       const std::size_t i = G.at(f, nodes[k]);
       if (!(G.m[i] > mass_threshold)) continue;
       separation_detail::correct_node<D, Real>(G, M, i);
     }
+  });
   return SIZE_MAX;
 }
 

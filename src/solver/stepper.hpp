@@ -3,8 +3,6 @@
 // decides once which arrays exist and which stages run.
 #pragma once
 
-#include <omp.h>
-
 #include <algorithm>
 #include <cctype>
 #include <chrono>
@@ -29,6 +27,7 @@
 #include "kernels/separation_extrapolation.hpp"
 #include "kernels/shape.hpp"
 #include "kernels/supports.hpp"
+#include "kernels/team.hpp"
 #include "model/bodies.hpp"
 #include "model/material.hpp"
 #include "scene/error.hpp"
@@ -114,8 +113,7 @@ class Stepper final : public Simulation {
   // The calling thread's particles in the loops that are not colored
   // (TileSchedule::thread_ranges): the particles of its colored passes.
   TileSchedule::Ranges my_particles() const {
-    return schedule_.thread_ranges(std::size_t(omp_get_num_threads()),
-                                   std::size_t(omp_get_thread_num()));
+    return schedule_.thread_ranges(std::size_t(team_size()), std::size_t(team_rank()));
   }
   void zero_grid(bool mm);
   template <unsigned What>

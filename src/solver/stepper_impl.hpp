@@ -248,8 +248,7 @@ std::uint32_t Stepper<D, Shape, Real>::key_of_position(std::size_t p) const {
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::sort_particles() {
   const std::size_t n = P_.n;
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-  for (std::size_t p = 0; p < n; ++p) P_.key[p] = key_of_position(p);
+  team_for(n >= kParallelMin, n, [&](std::size_t p) { P_.key[p] = key_of_position(p); });
   counting_sort(P_.key, n, tiles_.key_count(), offsets_, perm_, pcols_.id.data());
   // The keys first: the schedule of the new order says which thread's
   // loops take which particles, and so where every other column goes.
@@ -342,7 +341,7 @@ void Stepper<D, Shape, Real>::fused_step_tail() {
   const P2GOptions opt = p2g_options();
   const bool with_mm = mm && mm_fields_with_p2g_;  // what the next step's P2G scatters
   std::vector<G2PRangeResult> res(tiles_.tile_count);
-  std::size_t bad = SIZE_MAX, unsound = SIZE_MAX;
+  std::atomic<std::size_t> first_bad{SIZE_MAX}, first_unsound{SIZE_MAX};
   double part[3] = {0, 0, 0};  // thread 0: gradient G2P, constitutive, P2G
   // L of one tile per thread, columns a multiple of 64 bytes apart.
   const std::size_t l_stride = (max_tile_particles_ + 7) / 8 * 8;
@@ -351,11 +350,11 @@ void Stepper<D, Shape, Real>::fused_step_tail() {
   if (tail_L_.size() < team * l_block) tail_L_.assign(team * l_block, Real(0));
   for (std::size_t c = 0; c < schedule_.tiles.size(); ++c) {
     if (schedule_.tiles[c].empty()) continue;
-#pragma omp parallel reduction(min : bad, unsound) if (P_.n >= kParallelMin)
-    {
+    team_run(P_.n >= kParallelMin, [&] {
+      std::size_t bad = SIZE_MAX, unsound = SIZE_MAX;
       double mine[3] = {0, 0, 0};
       ParticleView<D, Real> Pt = P_;
-      Real* const scratch = tail_L_.data() + std::size_t(omp_get_thread_num()) * l_block;
+      Real* const scratch = tail_L_.data() + std::size_t(team_rank()) * l_block;
       for (auto [k, last] = color_share(c); k < last; ++k) {
         const std::uint32_t t = schedule_.tiles[c][k];
         const std::size_t b = schedule_.begin[t], e = schedule_.begin[t + 1];
@@ -378,10 +377,13 @@ void Stepper<D, Shape, Real>::fused_step_tail() {
         mine[1] += Sec(t2 - t1).count();
         mine[2] += Sec(t3 - t2).count();
       }
-      if (omp_get_thread_num() == 0)
+      if (team_rank() == 0)
         for (int i = 0; i < 3; ++i) part[i] += mine[i];
-    }
+      offer_min(first_bad, bad);
+      offer_min(first_unsound, unsound);
+    });
   }
+  const std::size_t bad = first_bad.load(), unsound = first_unsound.load();
   const double wall = Sec(Clock::now() - start).count();
   const double measured = part[0] + part[1] + part[2];
   const Stage stage[3] = {kStageG2P, kStageConstitutive, kStageP2G};
@@ -454,8 +456,7 @@ void Stepper<D, Shape, Real>::schedule_built() {
 // (kernels/binning.hpp TileSchedule).
 template <int D, class Shape, class Real>
 std::pair<std::size_t, std::size_t> Stepper<D, Shape, Real>::color_share(std::size_t color) const {
-  return schedule_.share(color, std::size_t(omp_get_num_threads()),
-                         std::size_t(omp_get_thread_num()));
+  return schedule_.share(color, std::size_t(team_size()), std::size_t(team_rank()));
 }
 
 // The node split for the current team size (kernels/node_ownership.hpp),
@@ -551,18 +552,22 @@ template <int D, class Shape, class Real>
 template <unsigned What>
 void Stepper<D, Shape, Real>::p2g(const char* label) {
   const P2GOptions opt = p2g_options();
-  std::size_t bad = SIZE_MAX;
+  std::atomic<std::size_t> first_bad{SIZE_MAX};
   for (std::size_t c = 0; c < schedule_.tiles.size(); ++c) {
     if (schedule_.tiles[c].empty()) continue;
-#pragma omp parallel reduction(min : bad) if (P_.n >= kParallelMin)
-    for (auto [k, last] = color_share(c); k < last; ++k) {
-      const std::uint32_t t = schedule_.tiles[c][k];
-      const std::size_t b = schedule_.begin[t], e = schedule_.begin[t + 1];
-      const std::size_t r = p2g_tile<What>(opt, b, e);
-      if (r != e) bad = std::min(bad, r);
-    }
+    team_run(P_.n >= kParallelMin, [&] {
+      std::size_t bad = SIZE_MAX;
+      for (auto [k, last] = color_share(c); k < last; ++k) {
+        const std::uint32_t t = schedule_.tiles[c][k];
+        const std::size_t b = schedule_.begin[t], e = schedule_.begin[t + 1];
+        const std::size_t r = p2g_tile<What>(opt, b, e);
+        if (r != e) bad = std::min(bad, r);
+      }
+      offer_min(first_bad, bad);
+    });
   }
-  if (bad != SIZE_MAX) fail_particle(label, bad, "its shape-function stencil left the grid");
+  if (const std::size_t bad = first_bad.load(); bad != SIZE_MAX)
+    fail_particle(label, bad, "its shape-function stencil left the grid");
 }
 
 // kernels/p2g_multimaterial.hpp: mx, vol, g only from the tiles that reach
@@ -650,8 +655,7 @@ void Stepper<D, Shape, Real>::g2p() {
   std::vector<G2PRangeResult> res(chunks);
   // Fixed chunks (the external work sums in chunk order whatever the
   // threads), each run by the thread whose particles it begins in.
-#pragma omp parallel if (n >= kParallelMin)
-  {
+  team_run(n >= kParallelMin, [&] {
     const TileSchedule::Ranges mine = my_particles();
     for (std::size_t r = 0; r < mine.count; ++r) {
       const auto [first, last] = mine.range[r];
@@ -660,7 +664,7 @@ void Stepper<D, Shape, Real>::g2p() {
         res[c] = g2p_range_of<What>(q, b, e);
       }
     }
-  }
+  });
   collect(res);
 }
 
@@ -671,11 +675,12 @@ void Stepper<D, Shape, Real>::g2p_colored() {
   std::vector<G2PRangeResult> res(tiles_.tile_count);
   for (std::size_t c = 0; c < schedule_.tiles.size(); ++c) {
     if (schedule_.tiles[c].empty()) continue;
-#pragma omp parallel if (P_.n >= kParallelMin)
-    for (auto [k, last] = color_share(c); k < last; ++k) {
-      const std::uint32_t t = schedule_.tiles[c][k];
-      res[t] = g2p_range_of<What>(q, schedule_.begin[t], schedule_.begin[t + 1]);
-    }
+    team_run(P_.n >= kParallelMin, [&] {
+      for (auto [k, last] = color_share(c); k < last; ++k) {
+        const std::uint32_t t = schedule_.tiles[c][k];
+        res[t] = g2p_range_of<What>(q, schedule_.begin[t], schedule_.begin[t + 1]);
+      }
+    });
   }
   collect(res);
 }
@@ -690,17 +695,19 @@ void Stepper<D, Shape, Real>::g2p_colored() {
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::constitutive() {
   const std::size_t n = P_.n;
-  std::size_t bad = SIZE_MAX;
+  std::atomic<std::size_t> first_bad{SIZE_MAX};
   // This step's dt (the last step may be shorter: step_within), set before
   // the threads read the table.
   isotropic_table_.dt = Real(dt_);
-#pragma omp parallel reduction(min : bad) if (n >= kParallelMin)
-  {
+  team_run(n >= kParallelMin, [&] {
     const TileSchedule::Ranges mine = my_particles();
+    std::size_t bad = SIZE_MAX;
     for (std::size_t r = 0; r < mine.count; ++r)
       bad = std::min(bad, constitutive_range(mine.range[r].first, mine.range[r].second));
-  }
-  if (bad != SIZE_MAX) fail_particle("constitutive", bad, "J <= 0 or a non-finite stress/volume");
+    offer_min(first_bad, bad);
+  });
+  if (const std::size_t bad = first_bad.load(); bad != SIZE_MAX)
+    fail_particle("constitutive", bad, "J <= 0 or a non-finite stress/volume");
 }
 
 template <int D, class Shape, class Real>
@@ -925,13 +932,10 @@ void Stepper<D, Shape, Real>::fold_mirrors(unsigned what, bool with_reaction) {
   if (reaction)
     for (MirrorPlane& mp : mirrors_)
       mp.fold_terms.resize(mp.ghost.size() * std::size_t(G_.fields * D));
-#pragma omp parallel if (G_.nodes * std::size_t(G_.fields) >= kParallelMin)
-  {
+  team_run(G_.nodes * std::size_t(G_.fields) >= kParallelMin, [&] {
     const auto [first, last] = own_.mine(G_.nodes);
     for (std::size_t i = 0; i < mirrors_.size(); ++i) {
-      if (i > 0) {
-#pragma omp barrier
-      }
+      if (i > 0) team_barrier();
       MirrorPlane& mp = mirrors_[i];
       const MirrorView<Real> v = mirror_view(mp);
       for (int f = 0; f < G_.fields; ++f)
@@ -940,7 +944,7 @@ void Stepper<D, Shape, Real>::fold_mirrors(unsigned what, bool with_reaction) {
                       reaction ? mp.fold_terms.data() + std::size_t(f) * v.count * D : nullptr,
                       first, last);
     }
-  }
+  });
   if (!reaction) return;
   for (MirrorPlane& mp : mirrors_) {
     const MirrorView<Real> v = mirror_view(mp);
@@ -958,18 +962,15 @@ void Stepper<D, Shape, Real>::fold_mirrors(unsigned what, bool with_reaction) {
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::mirror_ghost_velocities(bool with_dvel) {
   if (mirrors_.empty()) return;
-#pragma omp parallel if (G_.nodes * std::size_t(G_.fields) >= kParallelMin)
-  {
+  team_run(G_.nodes * std::size_t(G_.fields) >= kParallelMin, [&] {
     const auto [first, last] = own_.mine(G_.nodes);
     for (std::size_t i = mirrors_.size(); i-- > 0;) {
-      if (i + 1 < mirrors_.size()) {
-#pragma omp barrier
-      }
+      if (i + 1 < mirrors_.size()) team_barrier();
       const MirrorView<Real> v = mirror_view(mirrors_[i]);
       for (int f = 0; f < G_.fields; ++f)
         if (!plan_.rigid[std::size_t(f)]) mirror_velocities(G_, GV_, v, f, with_dvel, first, last);
     }
-  }
+  });
 }
 
 // A rigid material does work on the bodies like a moving support: the force
@@ -1026,15 +1027,14 @@ void Stepper<D, Shape, Real>::update_tractions() {
     const double tm = time_ + 0.5 * dt_;
     scale[l] = Real(ramp_fraction(tm, r));
   }
-#pragma omp parallel if (n >= kParallelMin)
-  {
+  team_run(n >= kParallelMin, [&] {
     const TileSchedule::Ranges mine = my_particles();
     for (std::size_t r = 0; r < mine.count; ++r)
       for (std::size_t p = mine.range[r].first; p < mine.range[r].second; ++p) {
         const Real s = load[p] == 255 ? Real(0) : scale[load[p]];
         for (int d = 0; d < D; ++d) P_.fext[d][p] = s * base[d][p];
       }
-  }
+  });
 }
 
 template <int D, class Shape, class Real>
