@@ -89,6 +89,23 @@ Scheme step_scene_scheme(const std::string& scene);
 // untimed step.
 using BlockTimes = std::array<double, 8>;
 BlockTimes time_block(Simulation& sim, int steps);
+// One pair of blocks per benchmark iteration, in the order x,y / y,x / ...
+// (so a steady drift of the host's load favours neither side): run_x() and
+// run_y() time one block each, appended to x and y. The iteration's time
+// is the pair's wall time.
+template <class RunX, class RunY>
+void alternate_blocks(benchmark::State& state, RunX&& run_x, RunY&& run_y,
+                      std::vector<BlockTimes>& x, std::vector<BlockTimes>& y) {
+  for (auto _ : state) {
+    const bool x_first = x.size() % 2 == 0;
+    const BlockTimes first = x_first ? run_x() : run_y();
+    const BlockTimes second = x_first ? run_y() : run_x();
+    x.push_back(x_first ? first : second);
+    y.push_back(x_first ? second : first);
+    benchmark::ClobberMemory();
+    state.SetIterationTime(first.back() + second.back());  // the last entry: the wall time
+  }
+}
 // Per stage and the whole step ("step"), from blocks x[i] and y[i] of the
 // same pairs: <nx><s> and <ny><s>, the minima in ns per particle per step
 // (`per` = 1e9 / (steps x particles)); <r><s>, the median over the pairs

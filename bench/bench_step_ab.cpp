@@ -49,16 +49,10 @@ void bm_step_ab(benchmark::State& state, const std::string& scene, const std::st
     Simulation& b = *sim_b;
     for (int k = 0; k < 3; ++k) a.step(), b.step();  // first sort, first touch
     std::vector<BlockTimes> ta, tb;
-    for (auto _ : state) {
-      const bool a_first = ta.size() % 2 == 0;
-      // Its untimed step: the caches after the other Simulation's block.
-      const BlockTimes first = time_block(a_first ? a : b, kSteps);
-      const BlockTimes second = time_block(a_first ? b : a, kSteps);
-      ta.push_back(a_first ? first : second);
-      tb.push_back(a_first ? second : first);
-      benchmark::ClobberMemory();
-      state.SetIterationTime(first[kStageCount] + second[kStageCount]);
-    }
+    // Each block's untimed step: the caches after the other Simulation's block.
+    alternate_blocks(
+        state, [&] { return time_block(a, kSteps); }, [&] { return time_block(b, kSteps); }, ta,
+        tb);
     const double per = 1e9 / (kSteps * double(a.particle_count()));
     set_paired_counters(state, tb, ta, per, "nsB_", "nsA_", "b_over_a_");
     state.counters["pairs"] = double(ta.size());

@@ -46,15 +46,8 @@ void bm_step_pair(benchmark::State& state, const std::string& scene) {
         sim.step();
       }
     std::vector<BlockTimes> one, two;
-    for (auto _ : state) {
-      const bool one_first = one.size() % 2 == 0;
-      const BlockTimes a = run_block(sim, one_first ? 1 : 2);
-      const BlockTimes b = run_block(sim, one_first ? 2 : 1);
-      one.push_back(one_first ? a : b);
-      two.push_back(one_first ? b : a);
-      benchmark::ClobberMemory();
-      state.SetIterationTime(a[kStageCount] + b[kStageCount]);
-    }
+    alternate_blocks(
+        state, [&] { return run_block(sim, 1); }, [&] { return run_block(sim, 2); }, one, two);
     const double per = 1e9 / (kSteps * double(sim.particle_count()));
     set_paired_counters(state, one, two, per, "ns1_", "ns2_", "speedup_");
     state.counters["pairs"] = double(one.size());

@@ -38,15 +38,9 @@ void bm_team(benchmark::State& state, const std::string& scene) {
       sim.step();
     }
     std::vector<BlockTimes> team, openmp;
-    for (auto _ : state) {
-      const bool team_first = team.size() % 2 == 0;
-      const BlockTimes a = run_block(sim, !team_first);
-      const BlockTimes b = run_block(sim, team_first);
-      team.push_back(team_first ? a : b);
-      openmp.push_back(team_first ? b : a);
-      benchmark::ClobberMemory();
-      state.SetIterationTime(a[kStageCount] + b[kStageCount]);
-    }
+    alternate_blocks(
+        state, [&] { return run_block(sim, false); }, [&] { return run_block(sim, true); }, team,
+        openmp);
     use_openmp_regions(false);
     const double per = 1e9 / (kSteps * double(sim.particle_count()));
     set_paired_counters(state, openmp, team, per, "nsB_", "nsA_", "speedup_");

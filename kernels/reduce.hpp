@@ -18,15 +18,6 @@ inline constexpr std::size_t kReduceChunk = 4096;
 // the work (about a microsecond per region, kernels/team.hpp).
 inline constexpr std::size_t kParallelMin = 8192;
 
-// The calling thread's contiguous block [first, last) of n items, the
-// block a schedule(static) loop would give it up to rounding: passes that
-// cut their work this way (and TileSchedule's colored passes, which follow
-// the particle order) keep each particle on one thread from pass to pass.
-inline std::pair<std::size_t, std::size_t> thread_block(std::size_t n, std::size_t threads,
-                                                        std::size_t i) {
-  return {n * i / threads, n * (i + 1) / threads};
-}
-
 inline std::size_t chunk_count(std::size_t n) {
   return (n + kReduceChunk - 1) / kReduceChunk;
 }

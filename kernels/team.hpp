@@ -36,6 +36,7 @@
 #include <string_view>
 #include <thread>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #if defined(__x86_64__) || defined(__i386__)
@@ -265,14 +266,21 @@ void team_run(bool parallel, Body&& body) {
   tl_member = saved;
 }
 
-// body(i) for i in [0, n), each member on its contiguous block (the blocks
-// of OpenMP's schedule(static) up to rounding).
+// The calling thread's contiguous block [first, last) of n items, the
+// block a schedule(static) loop would give it up to rounding: passes that
+// cut their work this way (and TileSchedule's colored passes, which follow
+// the particle order) keep each particle on one thread from pass to pass.
+inline std::pair<std::size_t, std::size_t> thread_block(std::size_t n, std::size_t threads,
+                                                        std::size_t i) {
+  return {n * i / threads, n * (i + 1) / threads};
+}
+
+// body(i) for i in [0, n), each member on its thread_block.
 template <class Body>
 void team_for(bool parallel, std::size_t n, Body&& body) {
   team_run(parallel, [&] {
-    const auto size = std::size_t(team_size()), rank = std::size_t(team_rank());
-    const std::size_t last = n * (rank + 1) / size;
-    for (std::size_t i = n * rank / size; i < last; ++i) body(i);
+    const auto [first, last] = thread_block(n, std::size_t(team_size()), std::size_t(team_rank()));
+    for (std::size_t i = first; i < last; ++i) body(i);
   });
 }
 
