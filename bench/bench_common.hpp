@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -31,6 +32,7 @@
 #include "kernels/particle_view.hpp"
 #include "kernels/reduce.hpp"
 #include "kernels/shape.hpp"
+#include "kernels/team.hpp"
 #include "kernels/weights.hpp"
 #include "model/staggered_array.hpp"
 #include "solver/storage.hpp"
@@ -131,9 +133,10 @@ inline double median(std::vector<double> v) {
 template <class Real>
 inline void restore_owned(Real* dst, const Real* src, std::size_t nodes, int fields) {
   const NodeOwnership even;
-#pragma omp parallel if (nodes * std::size_t(fields) >= kParallelMin)
-  for_own_nodes(even, nodes, fields, [&](std::size_t b, std::size_t e) {
-    std::memcpy(dst + b, src + b, (e - b) * sizeof(Real));
+  team_run(nodes * std::size_t(fields) >= kParallelMin, [&] {
+    for_own_nodes(even, nodes, fields, [&](std::size_t b, std::size_t e) {
+      std::memcpy(dst + b, src + b, (e - b) * sizeof(Real));
+    });
   });
 }
 
@@ -408,8 +411,7 @@ struct Binning {
   }
   void compute_keys(ParticleSet<D, Real>& S, const GridView<D, Real>& G) const {
     const std::size_t n = S.P.n;
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-    for (std::size_t p = 0; p < n; ++p) S.P.key[p] = key_of(S.P, G, p);
+    team_for(n >= kParallelMin, n, [&](std::size_t p) { S.P.key[p] = key_of(S.P, G, p); });
   }
   void count(ParticleSet<D, Real>& S) {
     counting_sort(S.P.key, S.P.n, tiles.key_count(), offsets, perm, S.id.data());
@@ -418,9 +420,7 @@ struct Binning {
     scratch_keys.resize(S.P.n);
     permute_in_place(S.P.key, scratch_keys.data(), perm.data(), S.P.n);
   }
-  void rebuild_ranges(const ParticleSet<D, Real>& S) {
-    schedule.build(tiles, S.P.key, S.P.n);
-  }
+  void rebuild_ranges(const ParticleSet<D, Real>& S) { schedule.build(tiles, S.P.key, S.P.n); }
   void permute_columns(ParticleSet<D, Real>& S) {
     permute_particle_columns(S, perm.data(), S.P.n, schedule, scratch_keys, scratch, scratch_bytes);
   }
@@ -440,18 +440,20 @@ struct Binning {
 // particle or SIZE_MAX; the smallest is returned.
 template <class Range>
 std::size_t colored_tiles(const TileSchedule& S, std::size_t n, const Range& range) {
-  std::size_t bad = SIZE_MAX;
+  std::atomic<std::size_t> first_bad{SIZE_MAX};
   for (std::size_t c = 0; c < S.tiles.size(); ++c) {
     if (S.tiles[c].empty()) continue;
-#pragma omp parallel reduction(min : bad) if (n >= kParallelMin)
-    for (auto [k, last] =
-             S.share(c, std::size_t(omp_get_num_threads()), std::size_t(omp_get_thread_num()));
-         k < last; ++k) {
-      const std::uint32_t t = S.tiles[c][k];
-      bad = std::min(bad, range(std::size_t(S.begin[t]), std::size_t(S.begin[t + 1])));
-    }
+    team_run(n >= kParallelMin, [&] {
+      std::size_t bad = SIZE_MAX;
+      for (auto [k, last] = S.share(c, std::size_t(team_size()), std::size_t(team_rank()));
+           k < last; ++k) {
+        const std::uint32_t t = S.tiles[c][k];
+        bad = std::min(bad, range(std::size_t(S.begin[t]), std::size_t(S.begin[t + 1])));
+      }
+      offer_min(first_bad, bad);
+    });
   }
-  return bad;
+  return first_bad.load();
 }
 
 // (a) The solver's colored scatter (Stepper::p2g), each tile added straight
@@ -481,19 +483,26 @@ std::size_t p2g_serial(const ParticleView<D, Real>& P, const GridView<D, Real>& 
 }
 
 // (c) Atomic scatter: particles split statically across the threads, every
-// grid addition an `omp atomic` (the same sums as p2g_range with
-// kMassMomentum | kForce, one field, no traction).
+// grid addition atomic (the same sums as p2g_range with kMassMomentum |
+// kForce, one field, no traction). A relaxed std::atomic_ref add compiles to
+// the compare-and-swap loop `omp atomic` makes of a floating-point add; it
+// runs on the solver's team, as every other parallel bench loop: a libgomp
+// region would leave its idle thread spinning for ~2.5 ms on the core the
+// next benchmark's team member needs (kernels/team.hpp).
 template <int D, class Shape, class Real>
 std::size_t p2g_atomic(const ParticleView<D, Real>& P, const GridView<D, Real>& G) {
   constexpr int NS = kStressComponents<D>;
   const std::array<Real, 3> inv_h{Real(1) / G.h[0], Real(1) / G.h[1], Real(1) / G.h[2]};
   const std::size_t n = P.n;
-  std::size_t bad = SIZE_MAX;
-#pragma omp parallel reduction(min : bad)
-  {
+  auto add = [](Real& to, Real v) {
+    std::atomic_ref<Real>(to).fetch_add(v, std::memory_order_relaxed);
+  };
+  std::atomic<std::size_t> first_bad{SIZE_MAX};
+  team_run(true, [&] {
     Stencil<D, Shape, Real> st{};
-#pragma omp for schedule(static)
-    for (std::size_t p = 0; p < n; ++p) {
+    std::size_t bad = SIZE_MAX;
+    const auto [first, last] = thread_block(n, std::size_t(team_size()), std::size_t(team_rank()));
+    for (std::size_t p = first; p < last; ++p) {
       if (!st.build(P, G, inv_h, p)) {
         bad = std::min(bad, p);
         continue;
@@ -515,20 +524,16 @@ std::size_t p2g_atomic(const ParticleView<D, Real>& P, const GridView<D, Real>& 
           f[1] = -(vs[5] * gk[0] + vs[1] * gk[1] + vs[3] * gk[2]);
           f[2] = -(vs[4] * gk[0] + vs[3] * gk[1] + vs[2] * gk[2]);
         }
-        const Real dm = w * mp;
-#pragma omp atomic
-        G.m[i] += dm;
+        add(G.m[i], w * mp);
         for (int d = 0; d < D; ++d) {
-          const Real dp = w * mv[d];
-#pragma omp atomic
-          G.p[d][i] += dp;
-#pragma omp atomic
-          G.f[d][i] += f[d];
+          add(G.p[d][i], w * mv[d]);
+          add(G.f[d][i], f[d]);
         }
       }
     }
-  }
-  return bad;
+    offer_min(first_bad, bad);
+  });
+  return first_bad.load();
 }
 
 // Floating-point operations of the kMassMomentum | kForce scatter per stencil

@@ -81,8 +81,7 @@ void bm_g2p(benchmark::State& state, int threads) {
   std::vector<G2PRangeResult> res(chunks);
   for (auto _ : state) {
     // As Stepper::g2p: fixed chunks, static schedule.
-#pragma omp parallel for schedule(static) if (n >= kParallelMin)
-    for (std::size_t c = 0; c < chunks; ++c) {
+    team_for(n >= kParallelMin, chunks, [&](std::size_t c) {
       const std::size_t b = c * kReduceChunk, e = std::min(n, b + kReduceChunk);
       if constexpr (Kernel == Gather::solver)
         res[c] = g2p_range<D, Shape, Real, What, false, false, false>(P, G, V, q, key_of, b, e);
@@ -92,7 +91,7 @@ void bm_g2p(benchmark::State& state, int threads) {
       else
         res[c] = g2p_range_pointwise<D, Shape, Real, What, false, false, false>(P, G, V, q, key_of,
                                                                                 b, e);
-    }
+    });
     keep(res.data());
     benchmark::ClobberMemory();
   }
@@ -189,12 +188,11 @@ void bm_constitutive(benchmark::State& state, int threads) {
   const IsotropicPoint<D, Real> update(c, dt);
   for (auto _ : state) {
     // As Stepper::constitutive runs it: each thread its block of particles.
-#pragma omp parallel if (P.n >= kParallelMin)
-    {
+    team_run(P.n >= kParallelMin, [&] {
       const auto [first, last] =
-          thread_block(P.n, std::size_t(omp_get_num_threads()), std::size_t(omp_get_thread_num()));
+          thread_block(P.n, std::size_t(team_size()), std::size_t(team_rank()));
       update_particles(P, nullptr, first, last, update);
-    }
+    });
     keep(P.s[0]);
     benchmark::ClobberMemory();
   }

@@ -21,6 +21,7 @@
 //
 // Grids: 2D 255 x 255 nodes (the 250 000-particle step's grid), 3D 41^3
 // (68 921 nodes), one field.
+#include <atomic>
 #include <chrono>
 #include <cmath>
 
@@ -84,17 +85,18 @@ GridFixture<D, Real>& grid_fixture() {
     const GridVelocity<D, Real>& V = fx->grid.V;
     fx->even.split = {0, G.nodes / 2 / kNodeCutAlign * kNodeCutAlign, G.nodes};
     use_threads(2);
-#pragma omp parallel
-    for_own_nodes(fx->even, G.nodes, 1, [&](std::size_t b, std::size_t e) {
-      for (std::size_t i = b; i < e; ++i) {
-        // Every node heavy: m between 1 and 4, so the loop does its full work.
-        G.m[i] = Real(1) + Real(i % 7) * Real(0.5);
-        for (int d = 0; d < D; ++d) {
-          G.p[d][i] = Real(0.1) * Real(d + 1);
-          G.f[d][i] = Real(0.01);
-          V.vel[d][i] = V.dvel[d][i] = Real(0);
+    team_run(true, [&] {
+      for_own_nodes(fx->even, G.nodes, 1, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) {
+          // Every node heavy: m between 1 and 4, so the loop does its full work.
+          G.m[i] = Real(1) + Real(i % 7) * Real(0.5);
+          for (int d = 0; d < D; ++d) {
+            G.p[d][i] = Real(0.1) * Real(d + 1);
+            G.f[d][i] = Real(0.01);
+            V.vel[d][i] = V.dvel[d][i] = Real(0);
+          }
         }
-      }
+      });
     });
     for (auto& e : fx->evict) e.assign(kEvictBytes, 1);
     return fx;
@@ -107,13 +109,14 @@ GridFixture<D, Real>& grid_fixture() {
 // loads would first write one back (not the state a step leaves).
 template <int D, class Real>
 void evict_caches(GridFixture<D, Real>& fx) {
-  unsigned sum = 0;
-#pragma omp parallel reduction(+ : sum)
-  {
-    std::vector<unsigned char>& buf = fx.evict[omp_get_thread_num() % 2];
-    for (std::size_t i = 0; i < buf.size(); i += 64) sum += buf[i];
-  }
-  keep(sum);
+  std::atomic<unsigned> sum{0};
+  team_run(true, [&] {
+    const std::vector<unsigned char>& buf = fx.evict[std::size_t(team_rank()) % 2];
+    unsigned mine = 0;
+    for (std::size_t i = 0; i < buf.size(); i += 64) mine += buf[i];
+    sum += mine;
+  });
+  keep(sum.load());
 }
 
 template <int D, class Real>
@@ -144,10 +147,11 @@ void bm_grid(benchmark::State& state, GridKernel kernel, bool evicted, int threa
         Real* a = V.vel[0];
         const Real* b = G.p[0];
         const Real* c = G.f[0];
-#pragma omp parallel if (G.nodes >= kParallelMin)
-        for_own_nodes(even, G.nodes, 1, [&](std::size_t lo, std::size_t hi) {
+        team_run(G.nodes >= kParallelMin, [&] {
+          for_own_nodes(even, G.nodes, 1, [&](std::size_t lo, std::size_t hi) {
 #pragma omp simd
-          for (std::size_t i = lo; i < hi; ++i) a[i] = b[i] + s * c[i];
+            for (std::size_t i = lo; i < hi; ++i) a[i] = b[i] + s * c[i];
+          });
         });
         break;
       }

@@ -13,6 +13,8 @@
 //   nsA_<s>, nsB_<s> the minima, ns per particle per step (A team, B OpenMP)
 // The 10^4-particle scenes are where the regions' fixed cost shows: a step
 // there is ~100 us on two threads, with ~34 regions.
+#include <chrono>
+#include <thread>
 #include <vector>
 
 #include "bench/bench_common.hpp"
@@ -26,6 +28,11 @@ constexpr int kSteps = 8;  // timed steps per block
 
 BlockTimes run_block(Simulation& sim, bool openmp) {
   use_openmp_regions(openmp);
+  // The other side's idle threads stop spinning first (libgomp's after
+  // ~2.5 ms, the team's after ~0.6 ms): a spinning thread of one runtime
+  // holds the core the other's member needs. The untimed step of
+  // time_block then wakes this side's threads.
+  std::this_thread::sleep_for(std::chrono::milliseconds(5));
   return time_block(sim, kSteps);
 }
 
