@@ -203,7 +203,7 @@ def p2g_section(R):
            "(kernels/window.hpp: a cell's particles add into a register block written once per "
            "cell, rows of the window as vectors); pointwise = the reference kernel that adds every "
            "particle into its stencil node by node (the kernel before the window). Atomic uses "
-           "the pointwise loop with `omp atomic` adds. Ratios > 1 mean the first named is slower. "
+           "the pointwise loop with atomic adds (`std::atomic_ref` compare-and-swap, as `omp atomic` compiles them; before 2026-11-30 `omp atomic` itself). Ratios > 1 mean the first named is slower. "
            "GFLOP/s and GB/s (colored windowed, 1 thread): flops of the pointwise sums "
            "(kP2GFlopsPerNode per stencil node) and the particle bytes streamed, per second.", ""]
     header = ["dim", "shape", "real", "windowed serial 1t", "windowed colored 1t", "windowed colored 2t",
