@@ -794,7 +794,7 @@ def main():
     full_run = f"bench/run --tag {tagged.group(1)}" if tagged else "bench/run"
     lines = ["# mmpm benchmark results", "",
              f"Tables written by `bench/table.py` from `bench/{os.path.basename(args.json)}`; reproduce with "
-             f"`{full_run}` (full, ~26 min on the 2096 MHz host, ~36 on the 2596 MHz one) or "
+             f"`{full_run}` (full, 26–37 min on the 2096 MHz host, ~36 on the 2596 MHz one) or "
              "`bench/run --quick` (subset, results on stdout). "
              "Only the notes at the end are hand-written.", "",
              f"- Date: {date}",
