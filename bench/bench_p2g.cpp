@@ -50,20 +50,25 @@ const char* strategy_name(Strategy s) {
   return "?";
 }
 
+// The block's edge in cells: 250 in 2D, 32 in 3D, unless a size sweep
+// (p2g_size) asks for another; the grid is the block plus 2 cells a side.
 template <int D>
-BlockSpec p2g_block(bool gimp) {
+constexpr int kDefaultBlockCells = D == 2 ? 250 : 32;
+
+template <int D>
+BlockSpec p2g_block(bool gimp, int cells) {
   BlockSpec b;
   b.ppc = 2;
   b.gimp = gimp;
   for (int d = 0; d < D; ++d) {
     b.lo[d] = 2;
-    b.hi[d] = D == 2 ? 252 : 34;
+    b.hi[d] = 2 + cells;
   }
   return b;
 }
 template <int D>
-std::array<int, 3> p2g_cells() {
-  return D == 2 ? std::array<int, 3>{254, 254, 1} : std::array<int, 3>{36, 36, 36};
+std::array<int, 3> p2g_cells(int cells) {
+  return {cells + 4, cells + 4, D == 2 ? 1 : cells + 4};
 }
 
 template <int D, class Shape, class Real>
@@ -75,12 +80,12 @@ struct P2GFixture {
 };
 
 template <int D, class Shape, class Real>
-P2GFixture<D, Shape, Real>& p2g_fixture(int tile) {
+P2GFixture<D, Shape, Real>& p2g_fixture(int tile, int cells) {
   using F = P2GFixture<D, Shape, Real>;
-  return cached_fixture<F>(tile, [tile] {
+  return cached_fixture<F>(std::pair{tile, cells}, [tile, cells] {
     auto fx = std::make_unique<F>();
-    make_block<D, Real>(fx->S, p2g_block<D>(std::is_same_v<Shape, GimpShape>));
-    fx->grid.setup(p2g_cells<D>(), 1, false, false);
+    make_block<D, Real>(fx->S, p2g_block<D>(std::is_same_v<Shape, GimpShape>, cells));
+    fx->grid.setup(p2g_cells<D>(cells), 1, false, false);
     fx->bins.template setup<Shape>(tile, fx->grid.G);
     fx->bins.sort(fx->S, fx->grid.G);
     for (std::size_t p = 0; p < fx->S.P.n; ++p) fx->total_mass += double(fx->S.P.m[p]);
@@ -89,9 +94,10 @@ P2GFixture<D, Shape, Real>& p2g_fixture(int tile) {
 }
 
 template <int D, class Shape, class Real>
-void bm_p2g(benchmark::State& state, Strategy strategy, int tile, int threads) {
+void bm_p2g(benchmark::State& state, Strategy strategy, int tile, int threads,
+            int cells = kDefaultBlockCells<D>) {
   use_threads(threads);
-  auto& fx = p2g_fixture<D, Shape, Real>(tile);
+  auto& fx = p2g_fixture<D, Shape, Real>(tile, cells);
   const ParticleView<D, Real>& P = fx.S.P;
   const GridView<D, Real>& G = fx.grid.G;
   constexpr unsigned What = kMassMomentum | kForce;
@@ -144,6 +150,7 @@ void bm_p2g(benchmark::State& state, Strategy strategy, int tile, int threads) {
   set_rate(state, "particle_GBps", n * double(kP2GParticleBytes<D, Shape, Real>));
   state.counters["tile"] = fx.bins.tiles.T;  // TileLayout rounds up to a power of two >= 4
   state.counters["threads"] = threads;
+  state.counters["particles"] = n;
 }
 
 template <int D, class Shape, class Real>
@@ -194,6 +201,26 @@ void register_tiles() {
     }
 }
 
+// The solver's colored scatter on blocks from a few thousand particles,
+// whose arrays and grid sit in the core's L2 (1 MiB here), to the 250 000
+// of p2g/ (L3). One thread. Why: the roofline bound (tools/roofline)
+// charges P2G its bytes at the triad's rate; if the kernel takes the same
+// time per particle when nothing comes from memory, its time is its own
+// instructions, and no memory-side change can bring it to that bound
+// (docs/performance.md "P2G's time without memory").
+template <int D, class Shape, class Real>
+void register_sizes(std::initializer_list<int> edges) {
+  for (int cells : edges) {
+    const std::string name = "p2g_size/dim:" + std::to_string(D) + "/shape:" + Shape::name +
+                             "/real:" + real_name<Real>() + "/cells:" + std::to_string(cells) +
+                             "/threads:1";
+    auto* b = benchmark::RegisterBenchmark(name.c_str(), [cells](benchmark::State& st) {
+      bm_p2g<D, Shape, Real>(st, Strategy::colored, kDefaultTile<D>, 1, cells);
+    });
+    configure(b->UseRealTime()->Unit(benchmark::kMicrosecond), 0.1);
+  }
+}
+
 template <int D, class Real>
 void register_shapes() {
   register_case<D, LinearShape, Real>();
@@ -217,6 +244,10 @@ void register_p2g() {
   register_tiles<3, GimpShape, double>();
   register_tiles<3, BSpline2Shape, double>();
   register_tiles<3, BSpline3Shape, double>();
+  register_sizes<2, LinearShape, double>({24, 48, 96, 250});
+  register_sizes<2, GimpShape, double>({24, 48, 96, 250});
+  register_sizes<2, GimpShape, float>({24, 48, 96, 250});
+  register_sizes<3, GimpShape, double>({8, 12, 20, 32});
 }
 
 }  // namespace mmpm::bench

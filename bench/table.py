@@ -271,6 +271,45 @@ def p2g_section(R):
         out.append(table(header, rows))
     else:
         out.append("(no tile sweep in this run)")
+    out += p2g_size_table(R)
+    return out
+
+
+# p2g_size: (dim, shape, real, block edges in cells, smallest to largest)
+P2G_SIZES = [("2", "linear", "double", ("24", "48", "96", "250")),
+             ("2", "gimp", "double", ("24", "48", "96", "250")),
+             ("2", "gimp", "float", ("24", "48", "96", "250")),
+             ("3", "gimp", "double", ("8", "12", "20", "32"))]
+
+
+def p2g_size_table(R):
+    """The colored scatter on one thread from an L2-resident block to the p2g/ block."""
+    out = ["", "### P2G against the block's size (colored windowed, 1 thread, ns/particle)", "",
+           "`p2g_size/`: the same kernel and particle layout as above on blocks of 2 × 2 (2D) or "
+           "2 × 2 × 2 (3D) particles per cell, from a few thousand particles, whose columns and grid "
+           "fit in one core's 1 MiB L2, to the blocks above (L3). block 1 / block 4: the share "
+           "of the large block's time that remains when nothing comes from beyond L2 — the "
+           "kernel's own instructions (docs/performance.md \"P2G's time without memory\").", ""]
+    rows = []
+    for dim, shape, real, edges in P2G_SIZES:
+        vals = []
+        for e in edges:
+            v = R.value("p2g_size", "ns_per_particle", dim=dim, shape=shape, real=real, cells=e,
+                        threads="1")
+            n = R.value("p2g_size", "particles", dim=dim, shape=shape, real=real, cells=e,
+                        threads="1")
+            vals.append((e, n, v))
+        if all(v is None for _, _, v in vals):
+            continue
+        cells = [f"{fmt(v, 2)} ({int(n):,} p)" if v is not None and n else fmt(v, 2)
+                 for _, n, v in vals]
+        share = pct(vals[0][2] / vals[-1][2]) if vals[0][2] and vals[-1][2] else "–"
+        rows.append([dim + "D", shape, real] + cells + [share])
+    if rows:
+        out.append(table(["dim", "shape", "real", "block 1 (L2)", "block 2", "block 3",
+                          "block 4 (as above)", "block 1 / block 4"], rows))
+    else:
+        out.append("(no size sweep in this run)")
     return out
 
 
