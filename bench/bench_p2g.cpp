@@ -150,7 +150,6 @@ void bm_p2g(benchmark::State& state, Strategy strategy, int tile, int threads,
   set_rate(state, "particle_GBps", n * double(kP2GParticleBytes<D, Shape, Real>));
   state.counters["tile"] = fx.bins.tiles.T;  // TileLayout rounds up to a power of two >= 4
   state.counters["threads"] = threads;
-  state.counters["particles"] = n;
 }
 
 template <int D, class Shape, class Real>
