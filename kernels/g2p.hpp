@@ -66,13 +66,14 @@ struct G2PGather {
   // same sums: bitwise the per-particle loads (docs/performance.md "Unit
   // loops kept inline; a window's grid values held for its run").
   //
-  // Two particles at a time (kPairs: 3D double windows of one row of 4
-  // nodes per unit, AVX-512): the window's rows are held twice over, one
-  // copy per 256-bit half, so a pair of particles of one window runs every
-  // product and sum in one 512-bit vector (gather_pair). The one-particle
-  // gather reads the lower half.
-  static constexpr bool kPairs =
-      Pairs && Windowed && D == 3 && Win::L == 4 && sizeof(Real) == 8 && kRegisterVectorBytes == 64;
+  // Two particles at a time (kPairs: double windows of one row of 4 nodes
+  // per unit, AVX-512: the shapes binned by the nearest node, 2D and 3D):
+  // the window's rows are held twice over, one copy per 256-bit half, so a
+  // pair of particles of one window runs every product and sum in one
+  // 512-bit vector (gather_pair). The one-particle gather reads the lower
+  // half.
+  static constexpr bool kPairs = Pairs && Windowed && Win::W == 4 && Win::L == 4 &&
+                                 sizeof(Real) == 8 && kRegisterVectorBytes == 64;
   using V2 = Lanes<Real, 8>;
   using HeldVec = std::conditional_t<kPairs, V2, typename Win::V>;
   struct WindowValues {
@@ -203,7 +204,8 @@ struct G2PGather {
   // depend on the thread's range without changing a result. Why: gather()
   // runs 4-lane vectors, half an AVX-512 register; pairs take 6-9 % off
   // the 3D G2P kernels on one thread (docs/performance.md "Two particles
-  // per vector in the 3D gathers").
+  // per vector in the 3D gathers"), and 2D's since its windows have 3 rows
+  // ("The same in 2D double").
   template <bool Motion, bool Gradient>
   [[gnu::always_inline]] void gather_pair(const Weights& wa, const Weights& wb,
                                           const GridVelocity<D, Real>& V, std::size_t b0,
@@ -217,34 +219,44 @@ struct G2PGather {
       constexpr int j = decltype(jc)::value, n = int(sizeof(VA) / sizeof(Real));
       return V2(__builtin_shufflevector(a, b, j, j, j, j, n + j, n + j, n + j, n + j));
     };
+    // 2D has no z factor: Window::Y is the y weight alone (wz, dwz unused).
     V2 wy[WY], dwy[WY], wz[WY], dwz[WY];
     static_for<WY>([&](auto jc) __attribute__((always_inline)) {
       constexpr int j = decltype(jc)::value;
       wy[j] = pair_lane(wa.wa, wb.wa, std::integral_constant<int, W + j>{});
-      wz[j] = pair_lane(wa.wa, wb.wa, std::integral_constant<int, 2 * W + j>{});
+      if constexpr (D == 3)
+        wz[j] = pair_lane(wa.wa, wb.wa, std::integral_constant<int, 2 * W + j>{});
       if constexpr (Gradient) {
         dwy[j] = pair_lane(wa.dwa, wb.dwa, std::integral_constant<int, W + j>{});
-        dwz[j] = pair_lane(wa.dwa, wb.dwa, std::integral_constant<int, 2 * W + j>{});
+        if constexpr (D == 3)
+          dwz[j] = pair_lane(wa.dwa, wb.dwa, std::integral_constant<int, 2 * W + j>{});
       }
     });
     V2 A[D] = {}, B[D] = {}, C[D] = {}, Q[D] = {};
     static_for<Win::units>([&](auto uc) __attribute__((always_inline)) {
       constexpr int u = decltype(uc)::value, jy = u % WY, jz = u / WY;  // one row per unit
       // Window::Y / GY / GZ: the y factor times the z factor, lane by lane.
-      const V2 Yu = wy[jy] * wz[jz];
+      V2 Yu = wy[jy];
+      if constexpr (D == 3) Yu = Yu * wz[jz];
       for (int d = 0; d < D; ++d) {
         const V2 vu = held.vel[d][u];
         A[d] += Yu * vu;
         if constexpr (Gradient) {
-          const V2 GYu = dwy[jy] * wz[jz], GZu = wy[jy] * dwz[jz];
-          B[d] += GYu * vu;
-          C[d] += GZu * vu;
+          if constexpr (D == 3) {
+            const V2 GYu = dwy[jy] * wz[jz], GZu = wy[jy] * dwz[jz];
+            B[d] += GYu * vu;
+            C[d] += GZu * vu;
+          } else {
+            B[d] += dwy[jy] * vu;
+          }
         }
         if constexpr (Motion) Q[d] += Yu * held.dvel[d][u];
       }
     });
-    const V2 X = __builtin_shufflevector(wa.wa, wb.wa, 0, 1, 2, 3, 16, 17, 18, 19);
-    const V2 GX = __builtin_shufflevector(wa.dwa, wb.dwa, 0, 1, 2, 3, 16, 17, 18, 19);
+    // Lanes 0-3 of a's x weights, then b's (n: lanes of a weight vector).
+    constexpr int n = int(sizeof(wa.wa) / sizeof(Real));
+    const V2 X = __builtin_shufflevector(wa.wa, wb.wa, 0, 1, 2, 3, n, n + 1, n + 2, n + 3);
+    const V2 GX = __builtin_shufflevector(wa.dwa, wb.dwa, 0, 1, 2, 3, n, n + 1, n + 2, n + 3);
     for (int d = 0; d < D; ++d) {
       // lanes_sum4 on each half: {sum XA, sum XQ, sum GX A, sum XB} per particle.
       const V2 a = X * A[d], q = X * Q[d], c = GX * A[d], e = X * B[d];
@@ -262,13 +274,12 @@ struct G2PGather {
         }
       }
     }
-    if constexpr (Gradient) {
+    if constexpr (Gradient && D == 3) {
       // L_d,z = lanes_sum(X C[d]) per particle: a serial sum from 0 (gather()'s
       // order), for the 3 directions and 2 particles at once. Transposed by
       // shuffles, lane 2d + k of the l-th vector added is lane l of particle
       // k's X C[d], so each sum gets its lanes in lanes_sum's order (24 lane
       // extracts and scalar adds were the alternative).
-      static_assert(D == 3);
       const V2 xc0 = X * C[0], xc1 = X * C[1], xc2 = X * C[2];
       V2 sum = V2{};
       static_for<4>([&](auto lc) __attribute__((always_inline)) {

@@ -175,13 +175,15 @@ struct BSpline3Shape {
 // Whether particles are binned by their nearest node k instead of their
 // cell: then every particle of a bin has the stencil k-1 .. k+1, and the
 // window needs 3 rows per y and z direction instead of 4
-// (kernels/window.hpp). Only in 3D double, where it saves 28 of 64 window
-// nodes (P2G -16..-22 %, G2P -12 %); in 2D double 3 rows of 4 doubles take
-// three half-register units where 4 rows take two full ones, and in float
-// 3 rows of 16 bytes fill no register (docs/performance.md "Windows centred
-// on the nearest node").
+// (kernels/window.hpp). In double, 2D and 3D: 3D saves 28 of 64 window
+// nodes (P2G -16..-22 %, G2P -12 %); 2D's three rows of 4 doubles are
+// three half-register units in the gathers, which run two particles per
+// register (G2PGather::gather_pair), and two padded full-register units in
+// the scatters (2D uGIMP step -8..-16 %). In float 3 rows of 16 bytes fill
+// no register (docs/performance.md "Windows centred on the nearest node",
+// "The same in 2D double").
 template <int D, class Shape, class Real>
-inline constexpr bool binned_by_nearest_node = (D == 3) &&
+inline constexpr bool binned_by_nearest_node = (D == 2 || D == 3) &&
                                                (sizeof(Real) == 8) && Shape::nearest_node_stencil;
 
 // The origin particles are binned from: the grid's, or half a cell below it

@@ -24,14 +24,15 @@
 // inward, so it never leaves the grid; a particle whose own stencil leaves
 // the grid is rejected as before.
 //
-// The key cell is the particle's cell, or in 3D double, for the shapes
-// whose stencil is the 3 nodes around the nearest node (uGIMP, quadratic
+// The key cell is the particle's cell, or in double, for the shapes whose
+// stencil is the 3 nodes around the nearest node (uGIMP, quadratic
 // B-spline), that node k: the cell of x + h/2 (kernels/shape.hpp
 // binned_by_nearest_node, key_origin). The window then has WY = 3 rows per
-// y and z direction instead of 4 (36 window nodes, not 64); x keeps W = 4
-// lanes, one 256-bit vector per row, the fourth lane's weight 0. The
-// gathers keep those 9 one-row units; the scatters, which add lane by lane,
-// take 2 rows per unit, the fifth unit padded (WindowUnits, ScatterUnits).
+// y and z direction instead of 4 (3D: 36 window nodes, not 64; 2D: 12, not
+// 16); x keeps W = 4 lanes, one 256-bit vector per row, the fourth lane's
+// weight 0. The gathers keep those one-row units (9 in 3D, 3 in 2D); the
+// scatters, which add lane by lane, take 2 rows per unit, the last unit
+// padded (WindowUnits, ScatterUnits).
 //
 // Per unit u the kernels use lane vectors X (x weights), GX (x derivatives)
 // and Y(u), GY(u), GZ(u) such that, lane by lane,
