@@ -229,8 +229,8 @@ def p2g_section(R):
                 rows.append([dim + "D", shape, real, fmt(s1), fmt(c1), fmt(c2), ratio(c1, c2), fmt(ps1),
                              fmt(pc1), fmt(pc2), ratio(pc1, c1), fmt(a2), ratio(a2, c2), fmt(gf), fmt(gb)])
     out.append(table(header, rows))
-    # Where the solver's block units take two window rows (3D uGIMP and
-    # quadratic B-splines in double): the one-row units, this run.
+    # Where the solver's block units take two window rows (uGIMP and
+    # quadratic B-splines in double, 2D and 3D): the one-row units, this run.
     rows = []
     for dim in ("2", "3"):
         tile = "16" if dim == "2" else "8"
@@ -246,9 +246,10 @@ def p2g_section(R):
                              ratio(r2, c2)])
     if rows:
         out += ["", "### Two window rows per vector unit vs one (colored windowed, ns/particle)", "",
-                "Windows binned by the nearest node have 9 rows of 4 nodes; the solver's scatter "
-                "blocks take 2 rows per AVX-512 vector (5 units, the last padded), the baseline one "
-                "row (9 half-register units). Bitwise the same grid (tests/test_p2g.cpp).", ""]
+                "Windows binned by the nearest node have 9 rows of 4 nodes in 3D, 3 in 2D; the "
+                "solver's scatter blocks take 2 rows per AVX-512 vector (3D: 5 units, 2D: 2, the "
+                "last padded), the baseline one row (9 or 3 half-register units). Bitwise the same "
+                "grid (tests/test_p2g.cpp).", ""]
         out.append(table(["dim", "shape", "real", "2 rows 1t", "1 row 1t", "1 row / 2 rows (1t)",
                           "2 rows 2t", "1 row 2t", "1 row / 2 rows (2t)"], rows))
     out += ["", "### Tile edge of the colored scatter (ns/particle; best per row in bold)", "",
@@ -323,7 +324,8 @@ def kernel_section(R):
            "as in the step; its reference column is the one-particle windowed kernel; in 3D "
            "also with the momenta scattered after each batch of 32 (GroupedScatter) instead of "
            "in the block beside the gathers (the solver's choice where both fit the registers). "
-              "G2P one particle per vector: the 3D double windowed gather without pairs of "
+              "G2P one particle per vector: the double windowed gather of the shapes binned by "
+              "the nearest node (uGIMP, quadratic B-spline; 2D and 3D) without pairs of "
               "particles per 512-bit vector, the solver's baseline in the same run. "
            "Constitutive: isotropic small-strain "
            "update (plane strain in 2D). Same particle blocks as P2G.", ""]
