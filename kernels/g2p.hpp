@@ -330,8 +330,8 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
   using Weights = typename Gather::Weights;
   // The windowed passes request the grid lines a line ahead; the pointwise
   // kernel (grids too small for a window) does not.
-  GridLinesAhead<Window<D, Shape, Real>> ahead(Windowed && q.prefetch_grid, off);
-  add_gather_arrays<What>(ahead, G, V);
+  auto ahead =
+      gather_lines_ahead<What, Window<D, Shape, Real>>(Windowed && q.prefetch_grid, off, G, V);
   // When the momentum block and the gather's sums (2D vectors) do not fit in
   // the registers together (3D cubic B-splines in double: 8 units x 3 + 6),
   // the momenta of a batch are scattered after its gathers, by

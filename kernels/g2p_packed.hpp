@@ -155,8 +155,7 @@ G2PRangeResult g2p_range_packed(const ParticleView<2, Real>& particles,
   const Real dt = Real(q.dt), flip = Real(q.flip), pic = Real(1) - Real(q.flip);
   const WindowBuilder<2, LinearShape, Real> builder(G);
   const auto off = Win::offsets(G);
-  GridLinesAhead<Win> ahead(q.prefetch_grid, off);
-  add_gather_arrays<What>(ahead, G, V);
+  auto ahead = gather_lines_ahead<What, Win>(q.prefetch_grid, off, G, V);
   const Real inv_hx = builder.inverse_spacing(0), inv_hy = builder.inverse_spacing(1);
   PackedBatch<Real, K, MultiField> batch;
   Block carried;  // current == SIZE_MAX: nothing carried (kScatter only)

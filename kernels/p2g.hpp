@@ -97,8 +97,7 @@ std::size_t p2g_range_grouped(const ParticleView<D, Real>& particles, const Grid
   const Real inv_t = Real(opt.inv_thickness);
   const WindowBuilder<D, Shape, Real> builder(G);
   GroupedScatter<D, Shape, Real, What, Traction, UG, Units> scatter(G);
-  GridLinesAhead<Win> ahead(opt.prefetch_grid, Win::offsets(G));
-  add_scatter_arrays<What>(ahead, G);
+  auto ahead = scatter_lines_ahead<What, Win>(opt.prefetch_grid, Win::offsets(G), G);
   Win w[kWeightBatch];
   ScatterSourceBatch<D, Real> q;
   std::size_t base[kWeightBatch];
@@ -136,8 +135,7 @@ std::size_t p2g_range_one_block(const ParticleView<D, Real>& particles,
   const auto off = Win::offsets(G);
   Block block;
   const WindowBuilder<D, Shape, Real> builder(G);
-  GridLinesAhead<Win> ahead(opt.prefetch_grid, off);
-  add_scatter_arrays<What>(ahead, G);
+  auto ahead = scatter_lines_ahead<What, Win>(opt.prefetch_grid, off, G);
   auto build = [&](std::size_t first, std::size_t n, Win * w, bool* ok)
       __attribute__((always_inline)) {
     builder.build_batch(P, first, n, w, ok);

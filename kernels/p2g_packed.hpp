@@ -190,8 +190,7 @@ std::size_t p2g_range_packed(const ParticleView<2, Real>& particles, const GridV
   const GridView<2, Real> G = grid;
   const WindowBuilder<2, LinearShape, Real> builder(G);
   const auto off = Block::Win::offsets(G);
-  GridLinesAhead<typename Block::Win> ahead(opt.prefetch_grid, off);
-  add_scatter_arrays<What>(ahead, G);
+  auto ahead = scatter_lines_ahead<What, typename Block::Win>(opt.prefetch_grid, off, G);
   const Real inv_t = Real(opt.inv_thickness);
   const Real inv_hx = builder.inverse_spacing(0), inv_hy = builder.inverse_spacing(1);
   PackedBatch<Real, K, MultiField> batch;

@@ -111,4 +111,43 @@ TEST(GridPrefetch, OnlyIn2D) {
   EXPECT_FALSE(GridLinesAhead<W3>(true, typename W3::Offsets{}).on());
 }
 
+TEST(GridPrefetch, RequestsOnlyWithEveryArrayOfTheirCount) {
+  // The counts are template arguments (kernels/grid_prefetch.hpp): a
+  // request reads every address of its count, so a pass missing one of its
+  // arrays must not request at all.
+  using W = Window<2, LinearShape, double>;
+  static_assert(scatter_array_count<kMassMomentum | kForce, 2>() == 5);
+  static_assert(scatter_array_count<kMomentumOnly, 2>() == 2);
+  static_assert(scatter_array_count<kMultimaterial | kDomainGradient, 2>() == 5);
+  std::vector<double> storage(16 * 64);
+  double* next = storage.data();
+  auto array = [&] { return (next += 64) - 64; };
+  GridView<2, double> G;
+  G.m = array();
+  G.vol = array();
+  for (int d = 0; d < 2; ++d) G.p[d] = array(), G.f[d] = array(), G.mx[d] = array();
+  GridVelocity<2, double> V;
+  for (int d = 0; d < 2; ++d) V.vel[d] = array(), V.dvel[d] = array();
+  const W::Offsets rows{0, 8};
+
+  auto scatter = [&](bool on) {
+    auto ahead = scatter_lines_ahead<kMassMomentum | kForce, W>(on, rows, G);
+    ahead.window(3);  // a hint: never faults, never writes
+    return ahead.on();
+  };
+  EXPECT_TRUE(scatter(true));
+  EXPECT_FALSE(scatter(false));
+  G.f[1] = nullptr;
+  EXPECT_FALSE(scatter(true));
+  // mx without the domain gradient g, which this grid lacks: on.
+  EXPECT_TRUE((scatter_lines_ahead<kMultimaterial, W>(true, rows, G).on()));
+  EXPECT_FALSE((scatter_lines_ahead<kMultimaterial | kDomainGradient, W>(true, rows, G).on()));
+
+  constexpr unsigned kMusl = kUpdateMotion | kScatterMomentum;
+  EXPECT_TRUE((gather_lines_ahead<kMusl, W>(true, rows, G, V).on()));
+  V.dvel[0] = nullptr;
+  EXPECT_FALSE((gather_lines_ahead<kMusl, W>(true, rows, G, V).on()));
+  EXPECT_TRUE((gather_lines_ahead<kVelocityGradient, W>(true, rows, G, V).on()));  // reads vel only
+}
+
 }  // namespace
