@@ -52,11 +52,22 @@ class GridLinesAhead {
     if constexpr (kRows > 1) row_step_ = rows[1];
   }
   // An array the pass only reads (the velocities) or also writes (the sums):
-  // kReads and kWrites of them, then seal(). A null array, or fewer than
-  // the counts, turns the requests off (they are hints; nothing is lost).
+  // kReads and kWrites of them, then seal(). Fewer or more than the counts
+  // turn the requests off (they are hints; nothing is lost).
   void read(const Real* a) { add(a, read_, reads_); }
   void write(const Real* a) { add(a, write_, writes_); }
-  void seal() { on_ = on_ && reads_ == kReads && writes_ == kWrites; }
+  void seal() {
+    on_ = on_ && reads_ == kReads && writes_ == kWrites;
+    // A null array (a pass without it) takes another's address: a request
+    // for a line already asked for, rather than one near address 0. All
+    // null: nothing to request.
+    std::uintptr_t any = 0;
+    for (const std::uintptr_t a : read_) any = any ? any : a;
+    for (const std::uintptr_t a : write_) any = any ? any : a;
+    if (any == 0 && kReads + kWrites > 0) on_ = false;
+    for (std::uintptr_t& a : read_) a = a ? a : any;
+    for (std::uintptr_t& a : write_) a = a ? a : any;
+  }
 
   bool on() const { return on_; }
 
@@ -89,11 +100,12 @@ class GridLinesAhead {
   using Addresses = std::array<std::uintptr_t, std::size_t(N)>;
   template <std::size_t N>
   void add(const Real* a, std::array<std::uintptr_t, N>& to, int& count) {
-    if (!a || count >= int(N)) {
+    if (count >= int(N)) {
       on_ = false;
+      ++count;
       return;
     }
-    to[std::size_t(count++)] = reinterpret_cast<std::uintptr_t>(a);
+    to[std::size_t(count++)] = reinterpret_cast<std::uintptr_t>(a);  // 0 if null: seal()
   }
   // One row's line in every array: `at` is the byte offset from an array's start.
   [[gnu::always_inline]] void request_row(std::uintptr_t at) const {

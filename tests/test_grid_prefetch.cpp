@@ -111,10 +111,11 @@ TEST(GridPrefetch, OnlyIn2D) {
   EXPECT_FALSE(GridLinesAhead<W3>(true, typename W3::Offsets{}).on());
 }
 
-TEST(GridPrefetch, RequestsOnlyWithEveryArrayOfTheirCount) {
+TEST(GridPrefetch, ArrayCountsAndMissingArrays) {
   // The counts are template arguments (kernels/grid_prefetch.hpp): a
-  // request reads every address of its count, so a pass missing one of its
-  // arrays must not request at all.
+  // request reads every address of its count. A pass missing one of its
+  // arrays requests the others (the missing one takes another's address);
+  // a pass missing all of them requests nothing.
   using W = Window<2, LinearShape, double>;
   static_assert(scatter_array_count<kMassMomentum | kForce, 2>() == 5);
   static_assert(scatter_array_count<kMomentumOnly, 2>() == 2);
@@ -138,16 +139,17 @@ TEST(GridPrefetch, RequestsOnlyWithEveryArrayOfTheirCount) {
   EXPECT_TRUE(scatter(true));
   EXPECT_FALSE(scatter(false));
   G.f[1] = nullptr;
+  EXPECT_TRUE(scatter(true));
+  G.m = G.p[0] = G.p[1] = G.f[0] = nullptr;
   EXPECT_FALSE(scatter(true));
-  // mx without the domain gradient g, which this grid lacks: on.
-  EXPECT_TRUE((scatter_lines_ahead<kMultimaterial, W>(true, rows, G).on()));
-  EXPECT_FALSE((scatter_lines_ahead<kMultimaterial | kDomainGradient, W>(true, rows, G).on()));
+  // The multimaterial arrays, g missing (this grid has none): on.
+  EXPECT_TRUE((scatter_lines_ahead<kMultimaterial | kDomainGradient, W>(true, rows, G).on()));
 
   constexpr unsigned kMusl = kUpdateMotion | kScatterMomentum;
-  EXPECT_TRUE((gather_lines_ahead<kMusl, W>(true, rows, G, V).on()));
-  V.dvel[0] = nullptr;
-  EXPECT_FALSE((gather_lines_ahead<kMusl, W>(true, rows, G, V).on()));
-  EXPECT_TRUE((gather_lines_ahead<kVelocityGradient, W>(true, rows, G, V).on()));  // reads vel only
+  EXPECT_TRUE((gather_lines_ahead<kMusl, W>(true, rows, G, V).on()));  // p missing
+  V.vel = {};
+  V.dvel = {};
+  EXPECT_FALSE((gather_lines_ahead<kUpdateMotion, W>(true, rows, G, V).on()));
 }
 
 }  // namespace
