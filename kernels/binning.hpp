@@ -90,7 +90,11 @@ struct TileLayout {
                                         const std::array<int, 3>& tiles) {
     std::uint32_t rank = 0, stride = 1, before = 0, below = 1;
     std::uint32_t above[3] = {1, 1, 1};  // prod_{d>k} half_d[p_d]
-    for (int d = D - 1; d > 0; --d) above[d - 1] = above[d] * half[d][t[d] & 1];
+    // Selects, not half[d][t[d] & 1]: indexed by a lane's value, GCC made
+    // that a vector gather in any_moved's loop, ~10 % of the 2D linear
+    // gradient pass's samples (docs/performance.md "The tile-change test
+    // without gathers").
+    for (int d = D - 1; d > 0; --d) above[d - 1] = above[d] * (t[d] & 1 ? half[d][1] : half[d][0]);
     for (int d = 0; d < D; ++d) {
       const std::uint32_t p = t[d] & 1;
       rank += (t[d] >> 1) * stride;
