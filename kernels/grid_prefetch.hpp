@@ -150,14 +150,19 @@ GridLinesAhead<Win, 0, scatter_array_count<What, D>()> scatter_lines_ahead(
 
 // The arrays a gather of `What` (kernels/g2p_particle.hpp) reads, and the
 // momenta MUSL's velocity pass adds to.
+template <unsigned What, int D>
+constexpr int gather_read_count() {
+  return D * (1 + int((What & kUpdateMotion) != 0));
+}
+template <unsigned What, int D>
+constexpr int gather_write_count() {
+  return D * int((What & kScatterMomentum) != 0);
+}
 template <unsigned What, class Win, int D, class Real>
-GridLinesAhead<Win, D*(1 + int((What & kUpdateMotion) != 0)),
-               D* int((What & kScatterMomentum) != 0)>
-gather_lines_ahead(bool on, const typename Win::Offsets& rows, const GridView<D, Real>& G,
-                   const GridVelocity<D, Real>& V) {
-  GridLinesAhead<Win, D*(1 + int((What & kUpdateMotion) != 0)),
-                 D* int((What & kScatterMomentum) != 0)>
-      ahead(on, rows);
+GridLinesAhead<Win, gather_read_count<What, D>(), gather_write_count<What, D>()> gather_lines_ahead(
+    bool on, const typename Win::Offsets& rows, const GridView<D, Real>& G,
+    const GridVelocity<D, Real>& V) {
+  GridLinesAhead<Win, gather_read_count<What, D>(), gather_write_count<What, D>()> ahead(on, rows);
   for (int d = 0; d < D; ++d) {
     ahead.read(V.vel[d]);
     if constexpr ((What & kUpdateMotion) != 0) ahead.read(V.dvel[d]);

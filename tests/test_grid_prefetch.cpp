@@ -120,6 +120,10 @@ TEST(GridPrefetch, ArrayCountsAndMissingArrays) {
   static_assert(scatter_array_count<kMassMomentum | kForce, 2>() == 5);
   static_assert(scatter_array_count<kMomentumOnly, 2>() == 2);
   static_assert(scatter_array_count<kMultimaterial | kDomainGradient, 2>() == 5);
+  static_assert(gather_read_count<kUpdateMotion, 2>() == 4);                      // vel, dvel
+  static_assert(gather_read_count<0, 3>() == 3);                                  // vel alone
+  static_assert(gather_write_count<kUpdateMotion | kScatterMomentum, 3>() == 3);  // MUSL's p
+  static_assert(gather_write_count<kUpdateMotion, 2>() == 0);
   std::vector<double> storage(16 * 64);
   double* next = storage.data();
   auto array = [&] { return (next += 64) - 64; };
