@@ -66,14 +66,14 @@ struct G2PGather {
   // same sums: bitwise the per-particle loads (docs/performance.md "Unit
   // loops kept inline; a window's grid values held for its run").
   //
-  // Two particles at a time (kPairs: double windows of one row of 4 nodes
-  // per unit, AVX-512: the shapes binned by the nearest node, 2D and 3D):
-  // the window's rows are held twice over, one copy per 256-bit half, so a
-  // pair of particles of one window runs every product and sum in one
-  // 512-bit vector (gather_pair). The one-particle gather reads the lower
-  // half.
-  static constexpr bool kPairs = Pairs && Windowed && Win::W == 4 && Win::L == 4 &&
-                                 sizeof(Real) == 8 && kRegisterVectorBytes == 64;
+  // Two particles at a time (kPairs: windows of one row of 4 nodes per
+  // unit, AVX-512: the shapes binned by the nearest node, 2D and 3D in
+  // double, 2D in float): the window's rows are held twice over, one copy
+  // per half vector, so a pair of particles of one window runs every
+  // product and sum in one vector (gather_pair; 512 bits in double, 256 in
+  // float). The one-particle gather reads the lower half.
+  static constexpr bool kPairs =
+      Pairs && Windowed && Win::W == 4 && Win::L == 4 && kRegisterVectorBytes == 64;
   using V2 = Lanes<Real, 8>;
   using HeldVec = std::conditional_t<kPairs, V2, typename Win::V>;
   struct WindowValues {

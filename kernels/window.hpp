@@ -262,14 +262,17 @@ struct WindowUnits {
 };
 
 // Rows per unit of the scatters: the most that fill at most `cap` (one
-// register's worth), as a power of two, whether or not they divide the rows.
-// 3D uGIMP and quadratic B-splines in double (9 rows of 4 nodes), with
-// AVX-512: 5 units of 2 rows, one register each, where Window has 9 of one
-// row, half a register (docs/performance.md "Two rows per unit in the 3D
-// scatter"); with AVX2 both are one row.
+// register's worth), as a power of two, whether or not they divide the rows,
+// up to the first power of two that covers them. 3D uGIMP and quadratic
+// B-splines in double (9 rows of 4 nodes), with AVX-512: 5 units of 2 rows,
+// one register each, where Window has 9 of one row, half a register
+// (docs/performance.md "Two rows per unit in the 3D scatter"); with AVX2
+// both are one row. 2D float binned by the nearest node (3 rows of 4
+// floats): one unit of 4 rows, the last one padding, as the 4-row window
+// had ("The same in 2D float").
 constexpr int scatter_rows_per_unit(int rows, int cap) {
   int ru = 1;
-  while (2 * ru <= cap && 2 * ru <= rows) ru *= 2;
+  while (2 * ru <= cap && ru < rows) ru *= 2;
   return ru;
 }
 template <int D, class Shape, class Real>

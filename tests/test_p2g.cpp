@@ -1193,17 +1193,18 @@ struct GatherOutputs {
   }
 };
 
-// Two particles per vector in the 2D and 3D double gathers of the shapes
-// binned by the nearest node (G2PGather::gather_pair, AVX-512 builds): each particle of a pair gets
+// Two particles per vector in the 2D and 3D double gathers and the 2D float
+// gathers of the shapes binned by the nearest node (G2PGather::gather_pair,
+// AVX-512 builds): each particle of a pair gets
 // the one-particle gather's bits, in every pass's mix of sums (motion, gradient, both); and a G2P
 // range gives the same bits when its start moves by one particle, so that
 // other particles pair up (as when a thread's range starts elsewhere).
 // Particles come in runs of 1-5 within 0.42 h of one node, in one field,
 // so the runs share windows; grid_cells<D>() cells, 2 fields, random grid
 // velocities.
-template <int D>
-Particles<D, double> node_runs(const Grid<D, double>& g, std::size_t n, unsigned seed) {
-  auto p = random_particles<D, double>(g.G, g.cells, n, seed);
+template <int D, class Real = double>
+Particles<D, Real> node_runs(const Grid<D, Real>& g, std::size_t n, unsigned seed) {
+  auto p = random_particles<D, Real>(g.G, g.cells, n, seed);
   std::mt19937_64 rng(seed + 7);
   std::uniform_real_distribution<double> U(0.0, 1.0);
   std::size_t i = 0;
@@ -1216,7 +1217,8 @@ Particles<D, double> node_runs(const Grid<D, double>& g, std::size_t n, unsigned
       centre[d] = double(g.G.origin[d]) + (node + 0.6 * (U(rng) - 0.5)) * double(g.G.h[d]);
     }
     for (std::size_t k = 0; k < run; ++k, ++i) {
-      for (int d = 0; d < D; ++d) p.x[d][i] = centre[d] + 0.24 * (U(rng) - 0.5) * double(g.G.h[d]);
+      for (int d = 0; d < D; ++d)
+        p.x[d][i] = Real(centre[d] + 0.24 * (U(rng) - 0.5) * double(g.G.h[d]));
       p.field[i] = std::uint8_t(field);
     }
     field ^= 1;
@@ -1224,17 +1226,17 @@ Particles<D, double> node_runs(const Grid<D, double>& g, std::size_t n, unsigned
   return p;
 }
 
-template <int D, class Shape, bool Motion, bool Gradient>
+template <int D, class Shape, class Real, bool Motion, bool Gradient>
 void check_pair_gather_bits(unsigned seed) {
-  using Gather = G2PGather<D, Shape, double, true>;
+  using Gather = G2PGather<D, Shape, Real, true>;
   if constexpr (!Gather::kPairs) {
     GTEST_SKIP() << "the pair gather needs AVX-512";
   } else {
     const bool gimp = std::string(Shape::name) == "gimp";
-    Grid<D, double> g(grid_cells<D>(), 2);
-    RandomGridVelocity<D, double> gv(g.G.nodes * 2, seed);
+    Grid<D, Real> g(grid_cells<D>(), 2);
+    RandomGridVelocity<D, Real> gv(g.G.nodes * 2, seed);
     const std::size_t n = 600;
-    auto p = node_runs<D>(g, n, seed);
+    auto p = node_runs<D, Real>(g, n, seed);
     const auto P = p.view(gimp);
     const Gather st(g.G);
     std::vector<typename Gather::Weights> w(n);
@@ -1244,8 +1246,8 @@ void check_pair_gather_bits(unsigned seed) {
     for (std::size_t i = 0; i + 1 < n; ++i) {
       const std::size_t fa = field_offset<true>(P, g.G, i), fb = field_offset<true>(P, g.G, i + 1);
       if (w[i].base + fa != w[i + 1].base + fb) continue;
-      double vn1[2][D] = {}, dv1[2][D] = {}, L1[2][D * D] = {};
-      double vn2[2][D] = {}, dv2[2][D] = {}, L2[2][D * D] = {};
+      Real vn1[2][D] = {}, dv1[2][D] = {}, L1[2][D * D] = {};
+      Real vn2[2][D] = {}, dv2[2][D] = {}, L2[2][D * D] = {};
       st.template gather<Motion, Gradient>(w[i], gv.V, fa, held_one, vn1[0], dv1[0], L1[0]);
       st.template gather<Motion, Gradient>(w[i + 1], gv.V, fb, held_one, vn1[1], dv1[1], L1[1]);
       st.template gather_pair<Motion, Gradient>(w[i], w[i + 1], gv.V, w[i].base + fa, held_pair,
@@ -1254,10 +1256,10 @@ void check_pair_gather_bits(unsigned seed) {
       EXPECT_EQ(std::memcmp(dv1, dv2, sizeof dv1), 0) << "dv, pair at " << i;
       EXPECT_EQ(std::memcmp(L1, L2, sizeof L1), 0) << "L, pair at " << i;
       if (Gradient) {
-        EXPECT_NE(L2[1][D + 1], 0.0);
+        EXPECT_NE(L2[1][D + 1], Real(0));
       }
       if (Motion) {
-        EXPECT_NE(vn2[1][D - 1], 0.0);
+        EXPECT_NE(vn2[1][D - 1], Real(0));
       }
       ++pairs;
     }
@@ -1265,23 +1267,23 @@ void check_pair_gather_bits(unsigned seed) {
   }
 }
 
-template <int D, class Shape>
+template <int D, class Shape, class Real = double>
 void check_pair_gather_range_start(unsigned seed) {
   const bool gimp = std::string(Shape::name) == "gimp";
-  Grid<D, double> g(grid_cells<D>(), 2);
-  RandomGridVelocity<D, double> gv(g.G.nodes * 2, seed);
+  Grid<D, Real> g(grid_cells<D>(), 2);
+  RandomGridVelocity<D, Real> gv(g.G.nodes * 2, seed);
   const std::size_t n = 600;
-  auto base = node_runs<D>(g, n, seed);
+  auto base = node_runs<D, Real>(g, n, seed);
   auto a = base, b = base;
   auto Pa = a.view(gimp), Pb = b.view(gimp);
-  GatherOutputs<D, double> out(a, Pa, Pb, false);
+  GatherOutputs<D, Real> out(a, Pa, Pb, false);
   G2PParams q;
   q.dt = 0.01;
   q.flip = 0.9;
   constexpr unsigned What = kUpdateMotion | kVelocityGradient;
-  g2p_range<D, Shape, double, What, true, true, false>(Pa, g.G, gv.V, q, NoKeys{}, 0, n);
-  g2p_range<D, Shape, double, What, true, true, false>(Pb, g.G, gv.V, q, NoKeys{}, 0, 1);
-  g2p_range<D, Shape, double, What, true, true, false>(Pb, g.G, gv.V, q, NoKeys{}, 1, n);
+  g2p_range<D, Shape, Real, What, true, true, false>(Pa, g.G, gv.V, q, NoKeys{}, 0, n);
+  g2p_range<D, Shape, Real, What, true, true, false>(Pb, g.G, gv.V, q, NoKeys{}, 0, 1);
+  g2p_range<D, Shape, Real, What, true, true, false>(Pb, g.G, gv.V, q, NoKeys{}, 1, n);
   for (int d = 0; d < D; ++d) {
     EXPECT_TRUE(bitwise_equal(a.v[d], b.v[d])) << "velocity " << d;
     EXPECT_TRUE(bitwise_equal(a.x[d], b.x[d])) << "position " << d;
@@ -1293,23 +1295,23 @@ void check_pair_gather_range_start(unsigned seed) {
 // (PairGathers = false) gives the same bits for each pass's mix of work:
 // USL's (motion and gradient), MUSL's first pass (motion, momentum
 // scattered after the batch) and its gradient pass (moving to x_next).
-template <int D, class Shape, unsigned What>
+template <int D, class Shape, unsigned What, class Real = double>
 void check_pairs_match_one_per_vector(unsigned seed) {
   const bool gimp = std::string(Shape::name) == "gimp";
-  Grid<D, double> ga(grid_cells<D>(), 2), gb(grid_cells<D>(), 2);
-  RandomGridVelocity<D, double> gv(ga.G.nodes * 2, seed);
+  Grid<D, Real> ga(grid_cells<D>(), 2), gb(grid_cells<D>(), 2);
+  RandomGridVelocity<D, Real> gv(ga.G.nodes * 2, seed);
   const std::size_t n = 600;
-  auto a = node_runs<D>(ga, n, seed), b = a;
+  auto a = node_runs<D, Real>(ga, n, seed), b = a;
   auto Pa = a.view(gimp), Pb = b.view(gimp);
   // x_next as MUSL's motion pass leaves it, for the gradient pass to commit.
-  GatherOutputs<D, double> out(a, Pa, Pb, true);
+  GatherOutputs<D, Real> out(a, Pa, Pb, true);
   const auto& [La, Lb, xa, xb] = out;
   G2PParams q;
   q.dt = 0.01;
   q.flip = 0.9;
-  const auto ra = g2p_range_impl<D, Shape, double, What, true, true, false, true, true>(
+  const auto ra = g2p_range_impl<D, Shape, Real, What, true, true, false, true, true>(
       Pa, ga.G, gv.V, q, NoKeys{}, 0, n);
-  const auto rb = g2p_range_impl<D, Shape, double, What, true, true, false, true, false>(
+  const auto rb = g2p_range_impl<D, Shape, Real, What, true, true, false, true, false>(
       Pb, gb.G, gv.V, q, NoKeys{}, 0, n);
   ASSERT_EQ(ra.bad, SIZE_MAX);
   ASSERT_EQ(rb.bad, SIZE_MAX);
@@ -1324,27 +1326,27 @@ void check_pairs_match_one_per_vector(unsigned seed) {
     EXPECT_TRUE(bitwise_equal(La[std::size_t(c)], Lb[std::size_t(c)])) << "L " << c;
   // Each pass changed something: the comparison is not of untouched arrays.
   if constexpr ((What & kUpdateMotion) != 0) {
-    EXPECT_FALSE(bitwise_equal(a.v[0], node_runs<D>(ga, n, seed).v[0]));
+    EXPECT_FALSE(bitwise_equal(a.v[0], node_runs<D, Real>(ga, n, seed).v[0]));
   }
   if constexpr ((What & kVelocityGradient) != 0) {
-    EXPECT_NE(La[std::size_t(D + 1)][n / 2], 0.0);
+    EXPECT_NE(La[std::size_t(D + 1)][n / 2], Real(0));
   }
   if constexpr ((What & kScatterMomentum) != 0) {
     EXPECT_NE(ga.sum(ga.G.p[1]), 0.0);
   }
 }
 
-template <int D>
+template <int D, class Real = double>
 void check_pairs_match_one_per_vector_every_pass(unsigned seed) {
   constexpr unsigned kUsl = kUpdateMotion | kVelocityGradient;
   constexpr unsigned kMuslMotion = kUpdateMotion | kScatterMomentum;
   constexpr unsigned kMuslGradient = kVelocityGradient | kCommitPosition;
-  check_pairs_match_one_per_vector<D, GimpShape, kUsl>(seed);
-  check_pairs_match_one_per_vector<D, GimpShape, kMuslMotion>(seed + 1);
-  check_pairs_match_one_per_vector<D, GimpShape, kMuslGradient>(seed + 2);
-  check_pairs_match_one_per_vector<D, BSpline2Shape, kUsl>(seed + 3);
-  check_pairs_match_one_per_vector<D, BSpline2Shape, kMuslMotion>(seed + 4);
-  check_pairs_match_one_per_vector<D, BSpline2Shape, kMuslGradient>(seed + 5);
+  check_pairs_match_one_per_vector<D, GimpShape, kUsl, Real>(seed);
+  check_pairs_match_one_per_vector<D, GimpShape, kMuslMotion, Real>(seed + 1);
+  check_pairs_match_one_per_vector<D, GimpShape, kMuslGradient, Real>(seed + 2);
+  check_pairs_match_one_per_vector<D, BSpline2Shape, kUsl, Real>(seed + 3);
+  check_pairs_match_one_per_vector<D, BSpline2Shape, kMuslMotion, Real>(seed + 4);
+  check_pairs_match_one_per_vector<D, BSpline2Shape, kMuslGradient, Real>(seed + 5);
 }
 TEST(G2PPairGather, WholeRangeSameBitsWithAndWithoutPairs) {
   check_pairs_match_one_per_vector_every_pass<3>(721);
@@ -1352,14 +1354,17 @@ TEST(G2PPairGather, WholeRangeSameBitsWithAndWithoutPairs) {
 TEST(G2PPairGather, WholeRangeSameBitsWithAndWithoutPairs2D) {
   check_pairs_match_one_per_vector_every_pass<2>(821);
 }
+TEST(G2PPairGather, WholeRangeSameBitsWithAndWithoutPairs2DFloat) {
+  check_pairs_match_one_per_vector_every_pass<2, float>(921);
+}
 
 // Every mix of sums a pass gathers: motion and gradient, motion alone,
 // gradient alone.
-template <int D, class Shape>
+template <int D, class Shape, class Real = double>
 void check_pair_gather_bits_every_mix(unsigned seed) {
-  check_pair_gather_bits<D, Shape, true, true>(seed);
-  check_pair_gather_bits<D, Shape, true, false>(seed + 1);
-  check_pair_gather_bits<D, Shape, false, true>(seed + 2);
+  check_pair_gather_bits<D, Shape, Real, true, true>(seed);
+  check_pair_gather_bits<D, Shape, Real, true, false>(seed + 1);
+  check_pair_gather_bits<D, Shape, Real, false, true>(seed + 2);
 }
 TEST(G2PPairGather, SameBitsAsOneParticleGimp) {
   check_pair_gather_bits_every_mix<3, GimpShape>(711);
@@ -1373,11 +1378,19 @@ TEST(G2PPairGather, SameBitsAsOneParticleGimp2D) {
 TEST(G2PPairGather, SameBitsAsOneParticleBSpline2_2D) {
   check_pair_gather_bits_every_mix<2, BSpline2Shape>(814);
 }
+TEST(G2PPairGather, SameBitsAsOneParticleGimp2DFloat) {
+  check_pair_gather_bits_every_mix<2, GimpShape, float>(911);
+}
+TEST(G2PPairGather, SameBitsAsOneParticleBSpline2_2DFloat) {
+  check_pair_gather_bits_every_mix<2, BSpline2Shape, float>(914);
+}
 TEST(G2PPairGather, RangeStartChangesNoBit) {
   check_pair_gather_range_start<3, GimpShape>(716);
   check_pair_gather_range_start<3, BSpline2Shape>(717);
   check_pair_gather_range_start<2, GimpShape>(816);
   check_pair_gather_range_start<2, BSpline2Shape>(817);
+  check_pair_gather_range_start<2, GimpShape, float>(916);
+  check_pair_gather_range_start<2, BSpline2Shape, float>(917);
 }
 
 // End positions of two G2P kernels that differ only where x + dt v may or
