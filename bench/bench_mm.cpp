@@ -141,7 +141,7 @@ void bm_mm(benchmark::State& state, Law law, NormalMethod normal, int threads) {
 
   std::vector<std::uint32_t> list;
   std::vector<unsigned char> flags;
-  std::vector<SavedGeometry<D, Real>> geometry;  // as the solver's stage: pass B reuses it
+  PassAGeometry<D, Real> geometry;  // as the solver's stage: pass B reuses it
   MMStats stats;
   double t_find = 0, t_a = 0, t_b = 0;
   for (auto _ : state) {

@@ -67,9 +67,32 @@ struct PairBatch {
   alignas(64) int limited[kLanes];
 };
 
-// What a batch reads besides m and p.
+// What pass B needs of pass A's batch in one chunk of the node list: which
+// entries went into which lane, and the lanes' masses, normals,
+// separations and stick flags (none of which change between the passes).
+// Why: pass B then neither sorts the chunk's nodes again (a mass load and
+// a branch per field and node) nor gathers the masses, and it copies the
+// geometry as contiguous rows instead of picking it out of the per-node
+// slots; in the 625 disks scene (20 000 multimaterial nodes) that sorting
+// and copying were about half of a pass B (docs/multimaterial.md "Pass B
+// from pass A's batches").
+template <int D, class Real>
+struct SavedBatch {
+  static constexpr int kLanes = PairBatch<D, Real>::kLanes;
+  int count = 0;  // 0: pass A batched nothing here; pass B sorts the chunk itself
+  int field_a = -1, field_b = -1;
+  const PairParams<Real>* params = nullptr;
+  signed char lane_of[kLanes];  // per entry of the chunk; −1: by the per-node path
+  std::uint32_t node[kLanes];
+  alignas(64) Real m[2][kLanes];
+  alignas(64) Real n[D][kLanes];
+  alignas(64) Real dn[kLanes];
+  alignas(64) unsigned char stick[kLanes];
+};
+
+// What a batch reads besides p.
 struct BatchNeeds {
-  bool vol = true, geometry = true, gradient = false, position = false, force = false;
+  bool mass = true, vol = true, geometry = true, gradient = false, position = false, force = false;
 };
 
 template <int D, class Real>
@@ -78,7 +101,8 @@ void gather_batch(const GridView<D, Real>& grid, const BatchNeeds& needs, PairBa
   const int n = B.count;
   for (int s = 0; s < 2; ++s) {
     const std::size_t o = base[s];
-    for (int i = 0; i < n; ++i) B.m[s][i] = grid.m[o + B.node[i]];
+    if (needs.mass)
+      for (int i = 0; i < n; ++i) B.m[s][i] = grid.m[o + B.node[i]];
     if (needs.vol)
       for (int i = 0; i < n; ++i) B.vol[s][i] = grid.vol[o + B.node[i]];
     for (int d = 0; d < D; ++d) {

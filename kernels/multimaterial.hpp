@@ -89,6 +89,16 @@ struct SavedGeometry {
   Real dn = 0;        // corrected normal separation (§4.3)
 };
 
+// What pass A leaves for pass B: per chunk of the list its batch, per
+// interaction of the per-node path its geometry.
+template <int D, class Real>
+struct PassAGeometry {
+  // Entry [k * F + a]; written only for the interactions pass A computed
+  // node by node (a batched lane's is in its chunk's batch).
+  std::vector<SavedGeometry<D, Real>> nodes;
+  std::vector<mm_detail::SavedBatch<D, Real>> batches;  // one per PairBatch::kLanes entries
+};
+
 // Checks a configuration once, outside the hot loops. nullptr when usable.
 template <int D, class Real>
 const char* validate_multimaterial(const GridView<D, Real>& grid, const MMConfig<D, Real>& cfg) {
@@ -666,29 +676,15 @@ void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::si
   for (int ia = 0; ia < K; ++ia) apply(nf.field[ia], change[ia], force[ia], Real(1));
 }
 
-// The list entries [begin, end) (at most one batch): two-material nodes of
-// the first batchable pair met go through a PairBatch, every other node
-// through process_node. The results are applied and the statistics added in
-// list order, so the sums are those of the per-node path.
+// Which entries of [begin, end) go into the batch B: two-material nodes of
+// the first pair met that batchable_pair takes, both fields deformable.
+// lane_of[k − begin] is the entry's lane, or −1 for the per-node path.
 template <int D, class Real, bool kPassA>
-void process_chunk(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg,
-                   const std::vector<std::uint32_t>& list, std::size_t begin, std::size_t end,
-                   const PassNeeds& needs, NodeFields<D, Real>& nf, PairBatch<D, Real>& B,
-                   const unsigned char* flags_in, unsigned char* flags_out,
-                   const SavedGeometry<D, Real>* geometry_in, SavedGeometry<D, Real>* geometry_out,
-                   ChunkStats& cs) {
-  auto per_node = [&](std::size_t k) {
-    process_node<D, Real, kPassA>(grid, cfg, k, list[k], needs, nf, flags_in, flags_out,
-                                  geometry_in, geometry_out, cs);
-  };
-  if (!cfg.batch_pairs || (!kPassA && !geometry_in)) {
-    for (std::size_t k = begin; k < end; ++k) per_node(k);
-    return;
-  }
-  assert(end - begin <= std::size_t(PairBatch<D, Real>::kLanes));
+void sort_chunk(const GridView<D, Real>& grid, const MMConfig<D, Real>& cfg,
+                const std::vector<std::uint32_t>& list, std::size_t begin, std::size_t end,
+                PairBatch<D, Real>& B, signed char* lane_of) {
   const int F = cfg.fields;
   auto is_rigid = [&](int field) { return cfg.rigid != nullptr && cfg.rigid[field] != 0; };
-  signed char lane_of[PairBatch<D, Real>::kLanes];
   B.count = 0;
   for (std::size_t k = begin; k < end; ++k) {
     lane_of[k - begin] = -1;
@@ -713,29 +709,101 @@ void process_chunk(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg,
     lane_of[k - begin] = static_cast<signed char>(B.count);
     B.node[B.count++] = std::uint32_t(node);
   }
+}
 
-  if (B.count > 0) {
+// Pass A's batch of one chunk, as pass B takes it (SavedBatch).
+template <int D, class Real>
+void save_batch(const PairBatch<D, Real>& B, const signed char* lane_of, int entries,
+                SavedBatch<D, Real>& S) {
+  S.count = B.count;
+  if (B.count == 0) return;
+  S.field_a = B.field_a;
+  S.field_b = B.field_b;
+  S.params = B.params;
+  const std::size_t rows = std::size_t(B.count) * sizeof(Real);
+  std::memcpy(S.lane_of, lane_of, std::size_t(entries));
+  std::memcpy(S.node, B.node, std::size_t(B.count) * sizeof(std::uint32_t));
+  for (int s = 0; s < 2; ++s) std::memcpy(S.m[s], B.m[s], rows);
+  for (int d = 0; d < D; ++d) std::memcpy(S.n[d], B.n[d], rows);
+  std::memcpy(S.dn, B.dn, rows);
+  std::memcpy(S.stick, B.stick, std::size_t(B.count));
+}
+
+// The list entries [begin, end) (at most one batch): two-material nodes of
+// the first batchable pair met go through a PairBatch, every other node
+// through process_node. The results are applied and the statistics added in
+// list order, so the sums are those of the per-node path.
+//
+// Pass A leaves its batch in *saved_out (when given) and the geometry of
+// its per-node entries in geometry_out. Pass B with *saved_in takes pass
+// A's lanes, masses, normals, separations and stick flags from it and
+// gathers only the momenta; where pass A batched nothing in the chunk
+// (every node by the per-node path, e.g. a pair with the exact
+// integration), it sorts the chunk itself with geometry_in.
+template <int D, class Real, bool kPassA>
+void process_chunk(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg,
+                   const std::vector<std::uint32_t>& list, std::size_t begin, std::size_t end,
+                   const PassNeeds& needs, NodeFields<D, Real>& nf, PairBatch<D, Real>& B,
+                   const unsigned char* flags_in, unsigned char* flags_out,
+                   const SavedGeometry<D, Real>* geometry_in, SavedGeometry<D, Real>* geometry_out,
+                   const SavedBatch<D, Real>* saved_in, SavedBatch<D, Real>* saved_out,
+                   ChunkStats& cs) {
+  auto per_node = [&](std::size_t k) {
+    process_node<D, Real, kPassA>(grid, cfg, k, list[k], needs, nf, flags_in, flags_out,
+                                  geometry_in, geometry_out, cs);
+  };
+  if (!cfg.batch_pairs || (!kPassA && !geometry_in)) {
+    for (std::size_t k = begin; k < end; ++k) per_node(k);
+    return;
+  }
+  assert(end - begin <= std::size_t(PairBatch<D, Real>::kLanes));
+  const int entries = int(end - begin);
+  signed char lane_of[PairBatch<D, Real>::kLanes];
+  if (!kPassA && saved_in && saved_in->count > 0) {
+    const SavedBatch<D, Real>& S = *saved_in;
+    B.count = S.count;
+    B.field_a = S.field_a;
+    B.field_b = S.field_b;
+    B.params = S.params;
+    const std::size_t rows = std::size_t(S.count) * sizeof(Real);
+    std::memcpy(lane_of, S.lane_of, std::size_t(entries));
+    std::memcpy(B.node, S.node, std::size_t(S.count) * sizeof(std::uint32_t));
+    for (int s = 0; s < 2; ++s) std::memcpy(B.m[s], S.m[s], rows);
+    for (int d = 0; d < D; ++d) std::memcpy(B.n[d], S.n[d], rows);
+    std::memcpy(B.dn, S.dn, rows);
+    std::memcpy(B.stick, S.stick, std::size_t(S.count));
     BatchNeeds bn;
-    if constexpr (kPassA) {
-      const NormalMethod method = B.params->normal_method;
-      bn.gradient = reads_domain_gradient(*B.params);
-      bn.position = method == NormalMethod::radial;
-      bn.force = cfg.use_force_difference;
-      gather_batch<D, Real>(grid, bn, B);
-      // The lanes read dt in the force limit only (explicit integration).
-      pass_a_batch<D, Real>(B, grid.h, cfg.stick_dt(), cfg.thickness, cfg.use_force_difference);
-    } else {
-      bn.vol = bn.geometry = false;
-      gather_batch<D, Real>(grid, bn, B);
-      for (std::size_t k = begin; k < end; ++k) {
-        const int i = lane_of[k - begin];
-        if (i < 0) continue;
-        const std::size_t slot = k * std::size_t(F) + std::size_t(B.field_a);
-        for (int d = 0; d < D; ++d) B.n[d][i] = geometry_in[slot].n[d];
-        B.dn[i] = geometry_in[slot].dn;
-        B.stick[i] = flags_in[slot];
+    bn.mass = bn.vol = bn.geometry = false;
+    gather_batch<D, Real>(grid, bn, B);
+    pass_b_batch<D, Real>(B);
+  } else {
+    sort_chunk<D, Real, kPassA>(grid, cfg, list, begin, end, B, lane_of);
+    if (B.count > 0) {
+      BatchNeeds bn;
+      if constexpr (kPassA) {
+        const NormalMethod method = B.params->normal_method;
+        bn.gradient = reads_domain_gradient(*B.params);
+        bn.position = method == NormalMethod::radial;
+        bn.force = cfg.use_force_difference;
+        gather_batch<D, Real>(grid, bn, B);
+        // The lanes read dt in the force limit only (explicit integration).
+        pass_a_batch<D, Real>(B, grid.h, cfg.stick_dt(), cfg.thickness, cfg.use_force_difference);
+      } else {
+        bn.vol = bn.geometry = false;
+        gather_batch<D, Real>(grid, bn, B);
+        for (std::size_t k = begin; k < end; ++k) {
+          const int i = lane_of[k - begin];
+          if (i < 0) continue;
+          const std::size_t slot = k * std::size_t(cfg.fields) + std::size_t(B.field_a);
+          for (int d = 0; d < D; ++d) B.n[d][i] = geometry_in[slot].n[d];
+          B.dn[i] = geometry_in[slot].dn;
+          B.stick[i] = flags_in[slot];
+        }
+        pass_b_batch<D, Real>(B);
       }
-      pass_b_batch<D, Real>(B);
+    }
+    if constexpr (kPassA) {
+      if (saved_out) save_batch<D, Real>(B, lane_of, entries, *saved_out);
     }
   }
 
@@ -763,9 +831,9 @@ void process_chunk(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg,
       cs.nodes_2 += 1;
       cs.energy += B.energy[i];
       cs.limited += B.limited[i];
-      const std::size_t slot = k * std::size_t(F) + std::size_t(B.field_a);
+      const std::size_t slot = k * std::size_t(cfg.fields) + std::size_t(B.field_a);
       flags_out[slot] = B.stick[i];
-      if (geometry_out) {
+      if (geometry_out && !saved_out) {  // else pass B reads the lane from the batch
         for (int d = 0; d < D; ++d) geometry_out[slot].n[d] = B.n[d][i];
         geometry_out[slot].dn = B.dn[i];
       }
@@ -783,8 +851,8 @@ struct alignas(64) ChunkCursor {
 template <int D, class Real, bool kPassA>
 void run_pass(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
               const MMConfig<D, Real>& cfg, MMStats& stats, const unsigned char* flags_in,
-              unsigned char* flags_out, const SavedGeometry<D, Real>* geometry_in,
-              SavedGeometry<D, Real>* geometry_out, const NodeOwnership& own) {
+              unsigned char* flags_out, const PassAGeometry<D, Real>* saved_in,
+              PassAGeometry<D, Real>* saved_out, const NodeOwnership& own) {
   assert(validate_multimaterial(grid, cfg) == nullptr);
   const int F = cfg.fields;
   if (stats.rigid_reaction.size() != std::size_t(F))
@@ -792,11 +860,15 @@ void run_pass(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
   const std::size_t n = list.size();
   if (n == 0) return;
   PassNeeds needs = pass_needs(cfg, kPassA);
-  if (geometry_in) needs.geometry = needs.gradient = needs.position = false;
+  if (saved_in) needs.geometry = needs.gradient = needs.position = false;
 
   // Fixed: the reduction order never depends on threads. One PairBatch.
   constexpr std::size_t kChunk = PairBatch<D, Real>::kLanes;
   const std::size_t chunks = (n + kChunk - 1) / kChunk;
+  const SavedGeometry<D, Real>* geometry_in = saved_in ? saved_in->nodes.data() : nullptr;
+  SavedGeometry<D, Real>* geometry_out = saved_out ? saved_out->nodes.data() : nullptr;
+  const SavedBatch<D, Real>* batches_in = saved_in ? saved_in->batches.data() : nullptr;
+  SavedBatch<D, Real>* batches_out = saved_out ? saved_out->batches.data() : nullptr;
   const std::size_t reaction_stride = 3 * std::size_t(F);
   std::vector<ChunkStats> partial(chunks);
   std::vector<double> reactions(chunks * reaction_stride, 0.0);
@@ -848,7 +920,9 @@ void run_pass(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
         local.reaction = reaction.data();
         const std::size_t end = std::min(n, (c + 1) * kChunk);
         process_chunk<D, Real, kPassA>(grid, cfg, list, c * kChunk, end, needs, nf, *batch,
-                                       flags_in, flags_out, geometry_in, geometry_out, local);
+                                       flags_in, flags_out, geometry_in, geometry_out,
+                                       batches_in ? &batches_in[c] : nullptr,
+                                       batches_out ? &batches_out[c] : nullptr, local);
         local.reaction = partial[c].reaction;
         std::copy(reaction.begin(), reaction.end(), local.reaction);
         partial[c] = local;
@@ -871,34 +945,39 @@ void run_pass(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
 // Pass A (ALGORITHM §2 step 3), after P2G filled m, p, mx, vol, g (and f if
 // cfg.use_force_difference). The caller zeroes grid.fi beforehand. stick_flags is resized
 // to list.size() * F and written: entry [k*F + a] holds the kStick* bits of the
-// interaction computed for field a at node list[k]. `geometry`, when given, is resized
-// the same way and receives each interaction's normal and corrected separation for
-// pass B. `own`: which thread starts on which nodes (kernels/node_ownership.hpp).
+// interaction computed for field a at node list[k]. `geometry`, when given, receives
+// each interaction's normal and corrected separation for pass B (PassAGeometry).
+// `own`: which thread starts on which nodes (kernels/node_ownership.hpp).
 template <int D, class Real>
 void multimaterial_pass_a(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
                           const MMConfig<D, Real>& cfg, MMStats& stats,
                           std::vector<unsigned char>& stick_flags, const NodeOwnership& own = {},
-                          std::vector<SavedGeometry<D, Real>>* geometry = nullptr) {
+                          PassAGeometry<D, Real>* geometry = nullptr) {
   stick_flags.assign(list.size() * std::size_t(cfg.fields), 0);
-  if (geometry) geometry->resize(list.size() * std::size_t(cfg.fields));
+  if (geometry) {
+    constexpr std::size_t kChunk = mm_detail::PairBatch<D, Real>::kLanes;
+    geometry->nodes.resize(list.size() * std::size_t(cfg.fields));
+    geometry->batches.resize((list.size() + kChunk - 1) / kChunk);
+  }
   mm_detail::run_pass<D, Real, true>(grid, list, cfg, stats, nullptr, stick_flags.data(), nullptr,
-                                     geometry ? geometry->data() : nullptr, own);
+                                     geometry, own);
 }
 
 // Pass B (ALGORITHM §2 step 5), after the grid momentum update, with the same list, the
 // same m, mx, vol, g and the stick_flags of pass A. No interface force, no energy.
-// With pass A's `geometry` it reads only m, vol and p at the nodes and takes the normal
-// and separation from pass A; without, it recomputes them (the same values).
+// With pass A's `geometry` it reads only m, vol and p at the nodes (only p at
+// pass A's batched nodes) and takes the normal and separation from pass A;
+// without, it recomputes them (the same values).
 template <int D, class Real>
 void multimaterial_pass_b(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
                           const MMConfig<D, Real>& cfg,
                           const std::vector<unsigned char>& stick_flags, MMStats& stats,
                           const NodeOwnership& own = {},
-                          const std::vector<SavedGeometry<D, Real>>* geometry = nullptr) {
+                          const PassAGeometry<D, Real>* geometry = nullptr) {
   assert(stick_flags.size() == list.size() * std::size_t(cfg.fields));
-  assert(!geometry || geometry->size() == stick_flags.size());
-  mm_detail::run_pass<D, Real, false>(grid, list, cfg, stats, stick_flags.data(), nullptr,
-                                      geometry ? geometry->data() : nullptr, nullptr, own);
+  assert(!geometry || geometry->nodes.size() == stick_flags.size());
+  mm_detail::run_pass<D, Real, false>(grid, list, cfg, stats, stick_flags.data(), nullptr, geometry,
+                                      nullptr, own);
 }
 
 }  // namespace mmpm

@@ -128,7 +128,7 @@ class MultimaterialStage {
   MMStats stats_;
   std::vector<std::uint32_t> list_;
   std::vector<unsigned char> stick_flags_;
-  std::vector<SavedGeometry<D, Real>> geometry_;  // pass A's, for pass B
+  PassAGeometry<D, Real> geometry_;  // pass A's, for pass B
 };
 
 }  // namespace mmpm
