@@ -4,7 +4,7 @@
 // joined by one interaction. Node by node, each costs a chain of square
 // roots and divisions (normal, tangent, h⊥, area, force limit) plus a dozen
 // scattered grid loads; in lanes across nodes the work of different nodes
-// overlaps (independent chains, array-by-array gathers), and the lane loops
+// overlaps (independent chains, one gather loop over the nodes), and the lane loops
 // run in SIMD registers: GCC vectorises both passes for every law (but
 // Coulomb friction in 3D pass A), checked in the solver binary by
 // tools/check_vectorised.py. Pass A's loop is written for
@@ -95,24 +95,27 @@ struct BatchNeeds {
   bool mass = true, vol = true, geometry = true, gradient = false, position = false, force = false;
 };
 
+// The batch's rows node by node: each node's index is loaded once for all
+// its rows. Why: row by row (an index load, a load and a store per row and
+// node) pass A's 16 rows in 2D cost one index load per value, and the
+// gather was more than half of pass A in the 625 disks' step; node by node
+// pass A alone went 548 -> 452 us on one thread (docs/multimaterial.md
+// "Pass B from pass A's batches"). The flags are loop invariants (GCC
+// unswitches the loop or predicts them).
 template <int D, class Real>
 void gather_batch(const GridView<D, Real>& grid, const BatchNeeds& needs, PairBatch<D, Real>& B) {
-  const std::size_t base[2] = {grid.at(B.field_a, 0), grid.at(B.field_b, 0)};
+  const std::size_t oa = grid.at(B.field_a, 0), ob = grid.at(B.field_b, 0);
   const int n = B.count;
-  for (int s = 0; s < 2; ++s) {
-    const std::size_t o = base[s];
-    if (needs.mass)
-      for (int i = 0; i < n; ++i) B.m[s][i] = grid.m[o + B.node[i]];
-    if (needs.vol)
-      for (int i = 0; i < n; ++i) B.vol[s][i] = grid.vol[o + B.node[i]];
+  for (int i = 0; i < n; ++i) {
+    const std::size_t a = oa + B.node[i], b = ob + B.node[i];
+    if (needs.mass) B.m[0][i] = grid.m[a], B.m[1][i] = grid.m[b];
+    if (needs.vol) B.vol[0][i] = grid.vol[a], B.vol[1][i] = grid.vol[b];
     for (int d = 0; d < D; ++d) {
-      for (int i = 0; i < n; ++i) B.p[s][d][i] = grid.p[d][o + B.node[i]];
-      if (needs.geometry)
-        for (int i = 0; i < n; ++i) B.mx[s][d][i] = grid.mx[d][o + B.node[i]];
-      if (needs.gradient)
-        for (int i = 0; i < n; ++i) B.g[s][d][i] = grid.g[d][o + B.node[i]];
-      if (needs.force)
-        for (int i = 0; i < n; ++i) B.f[s][d][i] = grid.f[d][o + B.node[i]];
+      B.p[0][d][i] = grid.p[d][a];
+      B.p[1][d][i] = grid.p[d][b];
+      if (needs.geometry) B.mx[0][d][i] = grid.mx[d][a], B.mx[1][d][i] = grid.mx[d][b];
+      if (needs.gradient) B.g[0][d][i] = grid.g[d][a], B.g[1][d][i] = grid.g[d][b];
+      if (needs.force) B.f[0][d][i] = grid.f[d][a], B.f[1][d][i] = grid.f[d][b];
     }
   }
   if (needs.position)
