@@ -288,19 +288,21 @@ TEST(MultimaterialPairBatch, UnusableNormalsSkippedAsPerNode3DFloat) {
 // with the exact integration: chunks mix batched nodes (the first pair met),
 // nodes of other pairs, nodes with three or four fields and rigid partners.
 template <int D, class Real>
+TestSetup<D, Real> mixed_four_fields() {
+  return mmpm::test::four_field_setup<D, Real>(
+      {Law::interface, Law::friction, Law::stick, Law::interface, Law::interface,
+       Law::frictionless},
+      {NormalMethod::mvg, NormalMethod::avg, NormalMethod::radial, NormalMethod::specified,
+       NormalMethod::rigid, NormalMethod::mvg},
+      3);
+}
+
+template <int D, class Real>
 void check_mixed_fields() {
-  auto setup = [] {
-    return mmpm::test::four_field_setup<D, Real>(
-        {Law::interface, Law::friction, Law::stick, Law::interface, Law::interface,
-         Law::frictionless},
-        {NormalMethod::mvg, NormalMethod::avg, NormalMethod::radial, NormalMethod::specified,
-         NormalMethod::rigid, NormalMethod::mvg},
-        3);
-  };
   TestGrid<D, Real> batched(dims_of(D), 4), per_node(dims_of(D), 4);
   fill_random(batched, 7);
   fill_random(per_node, 7);
-  auto s1 = setup(), s2 = setup();
+  auto s1 = mixed_four_fields<D, Real>(), s2 = mixed_four_fields<D, Real>();
   const Outcome o1 = run(batched, s1, true);
   const Outcome o2 = run(per_node, s2, false);
   EXPECT_GT(o2.stats.nodes_2, 50);
@@ -319,14 +321,6 @@ void check_mixed_fields() {
 // stale count or lane map differs by O(1).
 template <int D, class Real>
 void check_kept_geometry() {
-  auto four_fields = [] {
-    return mmpm::test::four_field_setup<D, Real>(
-        {Law::interface, Law::friction, Law::stick, Law::interface, Law::interface,
-         Law::frictionless},
-        {NormalMethod::mvg, NormalMethod::avg, NormalMethod::radial, NormalMethod::specified,
-         NormalMethod::rigid, NormalMethod::mvg},
-        3);
-  };
   auto exact_pair = [] {
     TestSetup<D, Real> setup(4, Real(1e-3));
     PairParams<Real> pp;
@@ -346,13 +340,14 @@ void check_kept_geometry() {
     for (const auto& dims : {larger, smaller}) {  // other grids, other lists
       TestGrid<D, Real> other(dims, 4);
       fill_random(other, 3);
-      auto s = four_fields();
+      auto s = mixed_four_fields<D, Real>();
       run(other, s, true, &kept);
     }
     TestGrid<D, Real> with_kept(dims_of(D), 4), with_fresh(dims_of(D), 4);
     fill_random(with_kept, 7);
     fill_random(with_fresh, 7);
-    auto s1 = exact ? exact_pair() : four_fields(), s2 = exact ? exact_pair() : four_fields();
+    auto s1 = exact ? exact_pair() : mixed_four_fields<D, Real>();
+    auto s2 = exact ? exact_pair() : mixed_four_fields<D, Real>();
     const Outcome o1 = run(with_kept, s1, true, &kept);
     const Outcome o2 = run(with_fresh, s2, true);
     EXPECT_GT(o2.stats.nodes_2, 50);
