@@ -729,6 +729,24 @@ void save_batch(const PairBatch<D, Real>& B, const signed char* lane_of, int ent
   std::memcpy(S.stick, B.stick, std::size_t(B.count));
 }
 
+// save_batch backwards: pass A's batch of the chunk into B and lane_of, for
+// pass B (which then gathers only the momenta).
+template <int D, class Real>
+void restore_batch(const SavedBatch<D, Real>& S, int entries, PairBatch<D, Real>& B,
+                   signed char* lane_of) {
+  B.count = S.count;
+  B.field_a = S.field_a;
+  B.field_b = S.field_b;
+  B.params = S.params;
+  const std::size_t rows = std::size_t(S.count) * sizeof(Real);
+  std::memcpy(lane_of, S.lane_of, std::size_t(entries));
+  std::memcpy(B.node, S.node, std::size_t(S.count) * sizeof(std::uint32_t));
+  for (int s = 0; s < 2; ++s) std::memcpy(B.m[s], S.m[s], rows);
+  for (int d = 0; d < D; ++d) std::memcpy(B.n[d], S.n[d], rows);
+  std::memcpy(B.dn, S.dn, rows);
+  std::memcpy(B.stick, S.stick, std::size_t(S.count));
+}
+
 // The list entries [begin, end) (at most one batch): two-material nodes of
 // the first batchable pair met go through a PairBatch, every other node
 // through process_node. The results are applied and the statistics added in
@@ -760,18 +778,7 @@ void process_chunk(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg,
   const int entries = int(end - begin);
   signed char lane_of[PairBatch<D, Real>::kLanes];
   if (!kPassA && saved_in && saved_in->count > 0) {
-    const SavedBatch<D, Real>& S = *saved_in;
-    B.count = S.count;
-    B.field_a = S.field_a;
-    B.field_b = S.field_b;
-    B.params = S.params;
-    const std::size_t rows = std::size_t(S.count) * sizeof(Real);
-    std::memcpy(lane_of, S.lane_of, std::size_t(entries));
-    std::memcpy(B.node, S.node, std::size_t(S.count) * sizeof(std::uint32_t));
-    for (int s = 0; s < 2; ++s) std::memcpy(B.m[s], S.m[s], rows);
-    for (int d = 0; d < D; ++d) std::memcpy(B.n[d], S.n[d], rows);
-    std::memcpy(B.dn, S.dn, rows);
-    std::memcpy(B.stick, S.stick, std::size_t(S.count));
+    restore_batch<D, Real>(*saved_in, entries, B, lane_of);
     BatchNeeds bn;
     bn.mass = bn.vol = bn.geometry = false;
     gather_batch<D, Real>(grid, bn, B);
