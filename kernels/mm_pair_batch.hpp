@@ -99,7 +99,7 @@ struct BatchNeeds {
 // its rows. Why: row by row (an index load, a load and a store per row and
 // node) pass A's 16 rows in 2D cost one index load per value, and the
 // gather was more than half of pass A in the 625 disks' step; node by node
-// pass A alone went 548 -> 452 us on one thread (docs/multimaterial.md
+// pass A alone went 530 -> 429 us on one thread (docs/multimaterial.md
 // "Pass B from pass A's batches"). The flags are loop invariants (GCC
 // unswitches the loop or predicts them).
 template <int D, class Real>
