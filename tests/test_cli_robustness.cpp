@@ -185,6 +185,7 @@ TEST(CliRobustness, AddressSpaceLimitIsSeenByTheMemoryGuard) {
 
 // A restart directory whose run.h5.partial is missing or damaged: exit 3
 // with HDF5's message before; it is bad input like a damaged checkpoint.
+// The message names the file (for a damaged snapshot, its own file).
 TEST(CliRobustness, RestartWithDamagedSnapshotsIsBadInput) {
   TempDir tmp;
   const fs::path dir = tmp / "stopped";
@@ -205,13 +206,25 @@ TEST(CliRobustness, RestartWithDamagedSnapshotsIsBadInput) {
     const char* name;
     void (*apply)(const fs::path&);
   };
+  // The partial is a directory of snapshot files (io/run_writer.hpp); the
+  // first one, step 0's, is one every restart keeps.
   const Damage damages[] = {
-      {"missing", [](const fs::path& f) { fs::remove(f); }},
-      {"truncated", [](const fs::path& f) { fs::resize_file(f, 5000); }},
-      {"garbage", [](const fs::path& f) { write_text(f, std::string(4096, 'x')); }},
+      {"missing", [](const fs::path& p) { fs::remove_all(p); }},
+      {"truncated",
+       [](const fs::path& p) {
+         const fs::path first = p / "step_0000000000.h5";
+         fs::resize_file(first, fs::file_size(first) / 2);
+       }},
+      {"garbage",
+       [](const fs::path& p) { write_text(p / "step_0000000000.h5", std::string(4096, 'x')); }},
+      {"a file, as an older mmpm left it",
+       [](const fs::path& p) {
+         fs::remove_all(p);
+         write_text(p, std::string(4096, 'x'));
+       }},
   };
   for (const Damage& d : damages) {
-    const fs::path copy = tmp / d.name;
+    const fs::path copy = tmp / ("damaged_" + std::to_string(&d - damages));
     fs::copy(dir, copy, fs::copy_options::recursive);
     d.apply(copy / "run.h5.partial");
     const CmdResult r = run_mmpm_within({"run", "--restart", copy.string(), "--quiet"}, 60);

@@ -400,6 +400,7 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
   };
   auto checkpoint = [&] {
     const auto t0 = Clock::now();
+    writer->sync();  // the snapshots the checkpoint refers to reach the disk first
     std::vector<io::Blob> blobs = sim->save_state();
     for (auto& b : driver_blobs(st, wall_so_far(), sim_stages())) blobs.push_back(std::move(b));
     blobs.push_back(io::make_string_blob(std::string(kSceneBlob), scene.source_text));
@@ -461,7 +462,13 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
           st.streak_start = -1;
         }
       }
-      if (s % series_every == 0 || stop)
+      // The last step's row is added here, before the checkpoint below, not
+      // after the loop: its multimaterial node counts, reactions and
+      // unresolved kinetic energy come from the step's grid, which a
+      // checkpoint does not hold, so a restart from a checkpoint at the last
+      // step used to write that row with 0 multimaterial nodes (2026-12-01).
+      const bool last = !(sim->time() < end_time - end_tolerance);
+      if (s % series_every == 0 || stop || last)
         add_series_row(*sim, st, sim_stages(), dim, energies_now());
       snapshot_if_due(false);
       if (stop) {
@@ -509,7 +516,14 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
   auto calls = sim->stage_calls();
   calls[kStageOutput] = output_calls;
   const Energies e = sim->energies();
-  const StepCounters c = sim->counters();
+  // The counters of the last step, from its series row: a run restarted
+  // from a checkpoint at its last step takes no step, and the simulation's
+  // own counters are then empty.
+  const auto last_of = [&](const char* column) {
+    for (std::size_t k = 0; k < st.names.size(); ++k)
+      if (st.names[k] == column) return static_cast<long>(st.columns[k].back());
+    throw std::logic_error(std::string("run driver: no series column ") + column);
+  };
   nlohmann::json j;
   j["scene"] = scene.name;
   j["dimension"] = dim;
@@ -537,9 +551,9 @@ RunOutcome drive(const Scene& scene, const RunOptions& opt, std::ostream& log, c
                  {"interface", e.interface},
                  {"external_work", e.external_work},
                  {"damping", e.damping}};
-  j["multimaterial_nodes"] = c.multimaterial_nodes;
-  j["nodes_3plus"] = c.nodes_3plus;
-  j["force_limited_nodes"] = c.force_limited_nodes;
+  j["multimaterial_nodes"] = last_of("multimaterial_nodes");
+  j["nodes_3plus"] = last_of("nodes_3plus");
+  j["force_limited_nodes"] = last_of("force_limited_nodes");
   j["stopped_by"] = stopped_by;
   // summary.json is written before run.h5 gets its name, and removed again
   // if that fails: a run either leaves both, or neither and its partial

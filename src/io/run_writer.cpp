@@ -1,13 +1,17 @@
 #include "io/run_writer.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <initializer_list>
+#include <map>
 #include <numeric>
+#include <optional>
 #include <set>
 #include <stdexcept>
 #include <string_view>
 #include <system_error>
+#include <utility>
 
 #include "io/atomic_file.hpp"
 #include "io/h5.hpp"
@@ -138,20 +142,6 @@ std::vector<double> padded_to_3(const std::vector<double>& xy, std::size_t count
   return xyz;
 }
 
-void remove_if_present(h5::Group& group, const std::string& name) {
-  if (group.contains(name)) group.remove(name);
-}
-
-// A snapshot lives in /particles and /grid and, for their padded 2D
-// vectors, in /xdmf and /xdmf_grid.
-void remove_snapshot(h5::Group& root, const std::string& name) {
-  for (const char* group_name : snapshot_groups) {
-    if (!root.contains(group_name)) continue;
-    h5::Group group = root.open_group(group_name);
-    remove_if_present(group, name);
-  }
-}
-
 // The 2D vector fields of a snapshot, padded with a zero third column
 // (xdmf.hpp: ParaView takes only 3-component data as vectors), in
 // support/<snapshot>/<field> shaped `shape`; nothing without such a field.
@@ -275,13 +265,6 @@ void write_snapshot_data(h5::Group& root, const Snapshot& s, const std::string& 
   }
 
   if (!s.grid.fields.empty()) write_grid_data(root, s, name);
-
-  h5::Group support = root.require_group(xdmf_group);
-  if (!support.contains(vertices_name(s.count))) {
-    std::vector<std::int64_t> ids(s.count);
-    std::iota(ids.begin(), ids.end(), std::int64_t{0});
-    support.write_ints(vertices_name(s.count), ids, {n});
-  }
   if (s.dimension == 2) write_padded_vectors(root, xdmf_group, name, s.fields, s.count, {n, 3});
 }
 
@@ -315,129 +298,253 @@ std::vector<XdmfSnapshot> describe(const h5::Group& root) {
   return out;
 }
 
-// Vertex-id lists no remaining snapshot uses (left by snapshots a restart
-// deleted) would make a restarted file differ from an uninterrupted one.
-void drop_unused_vertices(h5::Group& root, const std::vector<XdmfSnapshot>& snapshots) {
-  if (!root.contains(xdmf_group)) return;
-  h5::Group support = root.open_group(xdmf_group);
-  std::set<std::string> used;
-  for (const XdmfSnapshot& s : snapshots) used.insert(vertices_name(s.count));
-  for (const std::string& name : support.children()) {
-    if (name.rfind("vertices_", 0) == 0 && used.count(name) == 0) support.remove(name);
+// The vertex ids run.xdmf's polyvertex topologies refer to, one list per
+// particle count: written once at assembly, not with every snapshot.
+void write_vertex_ids(h5::Group& root, const std::vector<XdmfSnapshot>& snapshots) {
+  if (snapshots.empty()) return;
+  h5::Group support = root.require_group(xdmf_group);
+  for (const XdmfSnapshot& s : snapshots) {
+    if (support.contains(vertices_name(s.count))) continue;
+    std::vector<std::int64_t> ids(s.count);
+    std::iota(ids.begin(), ids.end(), std::int64_t{0});
+    support.write_ints(vertices_name(s.count), ids, {static_cast<hsize_t>(s.count)});
+  }
+}
+
+// HDF5's errors name a dataset or an operation ("cannot write dataset
+// 'stress': ... (File too large)"); the user needs the file too. An error
+// that already names its file passes through unchanged.
+struct FileError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+[[noreturn]] void rethrow_naming(const fs::path& file) {
+  try {
+    throw;
+  } catch (const FileError&) {
+    throw;
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    if (what.find(file.string()) != std::string::npos) throw FileError(what);
+    throw FileError(file.string() + ": " + what);
+  }
+}
+
+// Runs `operation`; a failure names `file`.
+template <class Operation>
+void naming(const fs::path& file, Operation&& operation) {
+  try {
+    operation();
+  } catch (...) {
+    rethrow_naming(file);
+  }
+}
+
+void copy_dataset(const h5::Group& from, const fs::path& source, h5::Group& to,
+                  const fs::path& target, const std::string& name) {
+  std::vector<double> values;
+  std::vector<hsize_t> shape;
+  naming(source, [&] {
+    const h5::Dataset dataset = from.open_dataset(name);
+    values = dataset.read_doubles();
+    shape = dataset.shape();
+  });
+  naming(target, [&] { to.write_doubles(name, values, shape); });
+}
+
+// Adds one snapshot file's groups to the run file being assembled: every
+// child of /particles, /grid, /xdmf and /xdmf_grid the run file lacks
+// (/grid's origin and spacing, the same in every file, come once). Copied
+// through our own reads and writes, not H5Ocopy: when a write under
+// H5Ocopy failed (a full disk), HDF5 1.10.8 crashed (SIGSEGV in
+// H5T_close_real) where our writes fail with a message. A failure names
+// the snapshot file when reading it failed, the run file otherwise.
+void copy_snapshot(const h5::Group& snapshot_root, const fs::path& source, h5::Group& run_root,
+                   const fs::path& target) {
+  for (const char* group_name : snapshot_groups) {
+    bool present = false;
+    naming(source, [&] { present = snapshot_root.contains(group_name); });
+    if (!present) continue;
+    const h5::Group from = snapshot_root.open_group(group_name);
+    std::vector<std::string> children;
+    naming(source, [&] { children = from.children(); });
+    h5::Group to = run_root.require_group(group_name);
+    for (const std::string& child : children) {
+      if (to.contains(child)) continue;
+      if (parse_step_name(child) < 0) {
+        copy_dataset(from, source, to, target, child);
+        continue;
+      }
+      std::optional<std::int64_t> step;
+      std::optional<double> time;
+      std::vector<std::string> fields;
+      std::optional<h5::Group> group;
+      naming(source, [&] {
+        group.emplace(from.open_group(child));
+        if (group->has_attribute("step")) step = group->int_attribute("step");
+        if (group->has_attribute("time")) time = group->double_attribute("time");
+        fields = group->children();
+      });
+      h5::Group copy = to.create_group(child);
+      if (step) copy.set_int_attribute("step", *step);
+      if (time) copy.set_double_attribute("time", *time);
+      for (const std::string& field : fields) copy_dataset(*group, source, copy, target, field);
+    }
+  }
+}
+
+void write_series_group(h5::Group& root, const std::vector<std::string>& names,
+                        const std::vector<std::vector<double>>& columns) {
+  std::string list;
+  for (std::size_t i = 0; i < names.size(); ++i) list += (i == 0 ? "" : ",") + names[i];
+  h5::Group series = root.create_group(series_group);
+  series.set_string_attribute("columns", list);
+  for (std::size_t i = 0; i < names.size(); ++i)
+    series.write_doubles(names[i], columns[i], {static_cast<hsize_t>(columns[i].size())});
+}
+
+// The step of a snapshot file's name (step_<10 digits>.h5), or -1.
+long snapshot_file_step(const fs::path& file) {
+  if (file.extension() != ".h5") return -1;
+  return parse_step_name(file.stem().string());
+}
+
+// The snapshot files in the partial directory, in step order.
+std::map<long, fs::path> snapshot_files(const fs::path& partial) {
+  std::map<long, fs::path> files;
+  for (const fs::directory_entry& entry : fs::directory_iterator(partial)) {
+    const long step = snapshot_file_step(entry.path());
+    if (step >= 0) files.emplace(step, entry.path());
+  }
+  return files;
+}
+
+// A snapshot file a restart keeps must open and hold its snapshot: a
+// damaged one is refused at the restart, not found at the run's end.
+void check_snapshot_file(const fs::path& file, long step) {
+  try {
+    const h5::File in = h5::File::open(file, h5::File::Mode::read_only);
+    const h5::Group root = in.root();
+    if (!root.contains(particles_group) ||
+        !root.open_group(particles_group).contains(step_name(step)))
+      throw std::runtime_error("holds no snapshot of step " + std::to_string(step));
+  } catch (...) {
+    rethrow_naming(file);
   }
 }
 
 }  // namespace
 
-RunWriter::RunWriter(fs::path dir, std::unique_ptr<h5::File> file)
-    : dir_(std::move(dir)), file_(std::move(file)) {}
+RunWriter::RunWriter(fs::path dir, bool open) : dir_(std::move(dir)), open_(open) {}
 
 RunWriter::RunWriter(const fs::path& dir) : dir_(dir) {
   fs::create_directories(dir_);
   fs::remove(h5_path());
   fs::remove(xdmf_path());
   fs::remove(grid_xdmf_path());
-  file_ = std::make_unique<h5::File>(h5::File::create(partial_path()));
-  file_->root().set_int_attribute("mmpm_layout", 1);
+  fs::remove_all(partial_path());
+  fs::create_directory(partial_path());
+  open_ = true;
 }
 
 RunWriter RunWriter::reopen(const fs::path& dir, long last_step) {
-  const fs::path partial = dir / "run.h5.partial";
+  RunWriter writer(dir, true);
+  const fs::path partial = writer.partial_path();
   if (!fs::exists(partial)) {
     throw std::runtime_error("cannot restart: " + partial.string() + " does not exist");
   }
-  RunWriter writer(dir,
-                   std::make_unique<h5::File>(h5::File::open(partial, h5::File::Mode::read_write)));
-  h5::Group root = writer.file_->root();
-  for (const char* group_name : snapshot_groups) {
-    if (!root.contains(group_name)) continue;
-    h5::Group group = root.open_group(group_name);
-    for (const std::string& name : group.children()) {
-      if (parse_step_name(name) > last_step) group.remove(name);
-    }
+  if (!fs::is_directory(partial)) {
+    // Until 2026-12-01 the partial was one HDF5 file.
+    throw std::runtime_error("cannot restart: " + partial.string() +
+                             " is not a directory of snapshots (written by an older mmpm)");
   }
-  remove_if_present(root, series_group);
-  writer.file_->flush();
+  std::vector<fs::path> stale;
+  for (const fs::directory_entry& entry : fs::directory_iterator(partial)) {
+    const long step = snapshot_file_step(entry.path());
+    // .tmp files and a half-assembled run.h5 are what a killed process was
+    // writing; later snapshots belong to steps the restart runs again.
+    if (step < 0 || step > last_step) stale.push_back(entry.path());
+  }
+  for (const fs::path& path : stale) fs::remove_all(path);
+  for (const auto& [step, file] : snapshot_files(partial)) check_snapshot_file(file, step);
+  if (last_step >= 0 && !fs::exists(writer.snapshot_path(last_step))) {
+    throw std::runtime_error(writer.snapshot_path(last_step).string() +
+                             ": missing (the checkpoint's last snapshot)");
+  }
+  fsync_directory(partial);
   fs::remove(writer.h5_path());
   fs::remove(writer.xdmf_path());
   fs::remove(writer.grid_xdmf_path());
   return writer;
 }
 
-RunWriter::RunWriter(RunWriter&&) noexcept = default;
+RunWriter::RunWriter(RunWriter&& other) noexcept
+    : dir_(std::move(other.dir_)),
+      open_(std::exchange(other.open_, false)),
+      attributes_(std::move(other.attributes_)),
+      series_(std::move(other.series_)),
+      has_series_(other.has_series_),
+      unsynced_(std::move(other.unsynced_)) {}
 
 RunWriter& RunWriter::operator=(RunWriter&& other) noexcept {
   if (this != &other) {
-    close_quietly();
     dir_ = std::move(other.dir_);
-    file_ = std::move(other.file_);
+    open_ = std::exchange(other.open_, false);
+    attributes_ = std::move(other.attributes_);
+    series_ = std::move(other.series_);
+    has_series_ = other.has_series_;
+    unsynced_ = std::move(other.unsynced_);
   }
   return *this;
 }
 
-RunWriter::~RunWriter() {
-  close_quietly();
-}
+RunWriter::~RunWriter() = default;
 
-void RunWriter::close_quietly() noexcept {
-  if (!is_open()) return;
-  try {
-    file_->close();
-  } catch (...) {
-    // Nothing to report to from here; the partial stays for restart.
-  }
-}
-
-bool RunWriter::is_open() const {
-  return file_ != nullptr && file_->valid();
+fs::path RunWriter::snapshot_path(long step) const {
+  return partial_path() / (step_name(step) + ".h5");
 }
 
 void RunWriter::require_open(const char* operation) const {
-  if (!is_open()) {
+  if (!open_) {
     throw std::logic_error(std::string("RunWriter::") + operation + " after finish() or abandon()");
   }
 }
 
-namespace {
-
-// HDF5's errors name a dataset or an operation ("cannot write dataset
-// 'stress': ... (File too large)"); the user needs the file too.
-[[noreturn]] void rethrow_naming(const fs::path& file) {
-  try {
-    throw;
-  } catch (const std::runtime_error& e) {
-    const std::string what = e.what();
-    if (what.find(file.string()) != std::string::npos) throw;
-    throw std::runtime_error(file.string() + ": " + what);
-  }
-}
-
-}  // namespace
-
 void RunWriter::set_attribute(const std::string& name, const std::string& value) {
   require_open("set_attribute");
-  file_->root().set_string_attribute(name, value);
+  attributes_[name] = value;
 }
 
 void RunWriter::write_snapshot(const Snapshot& snapshot) {
   require_open("write_snapshot");
   check_snapshot(snapshot);
   check_grid(snapshot);
-  h5::Group root = file_->root();
-  const std::string name = step_name(snapshot.step);
-  remove_snapshot(root, name);
+  const fs::path file = snapshot_path(snapshot.step);
+  fs::path tmp = file;
+  tmp += ".tmp";
   try {
-    write_snapshot_data(root, snapshot, name);
+    h5::File out = h5::File::create(tmp);
+    {
+      h5::Group root = out.root();
+      write_snapshot_data(root, snapshot, step_name(snapshot.step));
+    }  // every handle into the file is closed before the file itself
+    out.close();
+    fs::rename(tmp, file);
   } catch (...) {
-    // Leave no half-written snapshot behind (best effort: the file may be
-    // unwritable, which is likely why we are here).
-    try {
-      remove_snapshot(root, name);
-    } catch (...) {
-    }
-    rethrow_naming(partial_path());
+    std::error_code ignored;
+    fs::remove(tmp, ignored);
+    rethrow_naming(tmp);
   }
-  file_->flush();
+  if (std::find(unsynced_.begin(), unsynced_.end(), file) == unsynced_.end())
+    unsynced_.push_back(file);
+}
+
+void RunWriter::sync() {
+  require_open("sync");
+  if (unsynced_.empty()) return;
+  for (const fs::path& file : unsynced_) fsync_file(file);
+  fsync_directory(partial_path());
+  unsynced_.clear();
 }
 
 void RunWriter::write_series(const std::vector<std::string>& names,
@@ -448,7 +555,6 @@ void RunWriter::write_series(const std::vector<std::string>& names,
                                 std::to_string(columns.size()) + " columns");
   }
   std::set<std::string> seen;
-  std::string list;
   for (std::size_t i = 0; i < names.size(); ++i) {
     check_name(names[i], "time series");
     if (!seen.insert(names[i]).second) {
@@ -459,36 +565,47 @@ void RunWriter::write_series(const std::vector<std::string>& names,
                                   std::to_string(columns[i].size()) + " rows, '" + names[0] +
                                   "' has " + std::to_string(columns[0].size()));
     }
-    list += (i == 0 ? "" : ",") + names[i];
   }
-  try {
-    h5::Group root = file_->root();
-    remove_if_present(root, series_group);
-    h5::Group series = root.create_group(series_group);
-    series.set_string_attribute("columns", list);
-    for (std::size_t i = 0; i < names.size(); ++i) {
-      series.write_doubles(names[i], columns[i], {static_cast<hsize_t>(columns[i].size())});
-    }
-  } catch (...) {
-    rethrow_naming(partial_path());
-  }
-  file_->flush();
+  series_ = Series{names, columns};
+  has_series_ = true;
 }
 
 void RunWriter::finish(const std::function<void()>& before_publishing) {
   require_open("finish");
+  // Assembled inside the partial directory: a run killed while it is being
+  // written leaves it where a restart removes it.
+  const fs::path assembled = partial_path() / "run.h5";
   std::string document, grid_document;
-  {
-    h5::Group root = file_->root();
-    const std::vector<XdmfSnapshot> snapshots = describe(root);
-    drop_unused_vertices(root, snapshots);
-    document = xdmf_document("run.h5", snapshots);
-    const std::vector<XdmfGridSnapshot> grids = describe_grid(root);
-    if (!grids.empty()) grid_document = xdmf_grid_document("run.h5", grids);
-  }  // every handle into the file is closed before the file itself
-  file_->close();
-  // The data must be on disk before the name that promises a complete result.
-  fsync_file(partial_path());
+  try {
+    h5::File out = h5::File::create(assembled);
+    {
+      h5::Group root = out.root();
+      root.set_int_attribute("mmpm_layout", 1);
+      for (const auto& [name, value] : attributes_) root.set_string_attribute(name, value);
+      for (const auto& [step, file] : snapshot_files(partial_path())) {
+        std::optional<h5::File> in;
+        std::optional<h5::Group> in_root;
+        naming(file, [&] {
+          in.emplace(h5::File::open(file, h5::File::Mode::read_only));
+          in_root.emplace(in->root());
+        });
+        copy_snapshot(*in_root, file, root, assembled);
+      }
+      if (has_series_) write_series_group(root, series_.names, series_.columns);
+      const std::vector<XdmfSnapshot> snapshots = describe(root);
+      write_vertex_ids(root, snapshots);
+      document = xdmf_document("run.h5", snapshots);
+      const std::vector<XdmfGridSnapshot> grids = describe_grid(root);
+      if (!grids.empty()) grid_document = xdmf_grid_document("run.h5", grids);
+    }
+    out.close();
+    // The data must be on disk before the name that promises a complete result.
+    fsync_file(assembled);
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove(assembled, ignored);
+    rethrow_naming(assembled);
+  }
   // Everything else first: if a write fails (a full disk), run.h5 does not
   // appear, the partial stays and the run can be restarted from its
   // checkpoint once there is room.
@@ -496,23 +613,28 @@ void RunWriter::finish(const std::function<void()>& before_publishing) {
     write_file_atomic(xdmf_path(), document);
     if (!grid_document.empty()) write_file_atomic(grid_xdmf_path(), grid_document);
     if (before_publishing) before_publishing();
-    fs::rename(partial_path(), h5_path());
+    fs::rename(assembled, h5_path());
   } catch (...) {
     std::error_code ignored;
     fs::remove(xdmf_path(), ignored);
     fs::remove(grid_xdmf_path(), ignored);
+    fs::remove(assembled, ignored);
     throw;
   }
   fsync_directory(dir_);
+  open_ = false;
+  // run.h5 holds every snapshot now; a failure to tidy up loses nothing.
+  std::error_code ignored;
+  fs::remove_all(partial_path(), ignored);
 }
 
 void RunWriter::abandon() {
-  // A closed file means finish() or abandon() already ran (or this writer
-  // was moved from): there is no partial of ours to delete.
-  if (!is_open()) return;
-  close_quietly();  // the file is being discarded: a close failure changes nothing
+  // finish() or abandon() already ran (or this writer was moved from):
+  // there is no partial of ours to delete.
+  if (!open_) return;
+  open_ = false;
   std::error_code ignored;
-  fs::remove(partial_path(), ignored);
+  fs::remove_all(partial_path(), ignored);
 }
 
 }  // namespace mmpm::io

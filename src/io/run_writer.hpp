@@ -3,13 +3,21 @@
 //
 // DIR/run_grid.xdmf opens /grid in ParaView when the run wrote grid data.
 //
-// While a run is going the file is DIR/run.h5.partial; only finish() gives it
-// its real name, so a run.h5 is always a complete result. A killed run leaves
-// its .partial behind for `mmpm run --restart` (see reopen()).
+// While a run is going its snapshots are files of their own, in the
+// directory DIR/run.h5.partial/: step_<10-digit step>.h5, each in run.h5's
+// layout below holding that one snapshot, each written as a .tmp file and
+// renamed once complete (and fsync'd before the next checkpoint, sync()).
+// Only finish() assembles run.h5 from
+// them (in run.h5.partial/run.h5, renamed to DIR/run.h5 once complete), so a
+// run.h5 is always a complete result, and a run killed at any instant, even
+// in the middle of a write, leaves every snapshot it had finished intact for
+// `mmpm run --restart` (see reopen()). One HDF5 file written in place was
+// not safe: a SIGKILL during a write left its free-space metadata
+// inconsistent and the whole file unreadable (2026-12-01).
 //
 // Layout of run.h5 (all floating-point data in double precision):
 //   /                           string attributes from set_attribute(),
-//                               int attribute mmpm_layout = 1
+//                               int attribute mmpm_layout = 1 (run.h5 only)
 //   /particles/step_0000000420  attributes step (int64), time (double)
 //       position                [count x dimension]
 //       <field>                 [count x components], one per ParticleField
@@ -28,15 +36,11 @@
 #include <cstddef>
 #include <filesystem>
 #include <functional>
-#include <memory>
+#include <map>
 #include <string>
 #include <vector>
 
 namespace mmpm::io {
-
-namespace h5 {
-class File;  // io/h5.hpp; kept out of this header so users need no HDF5 headers
-}
 
 struct ParticleField {
   std::string name;  // letters, digits, '_', '.', '-'; not "position"
@@ -66,67 +70,89 @@ struct Snapshot {
 
 class RunWriter {
  public:
-  // Creates DIR (and parents) and DIR/run.h5.partial, truncating any old
-  // partial. A run.h5 / run.xdmf left from an earlier run in DIR is deleted
-  // first: it does not describe this run.
+  // Creates DIR (and parents) and an empty DIR/run.h5.partial/, deleting any
+  // old partial. A run.h5 / run.xdmf left from an earlier run in DIR is
+  // deleted first: it does not describe this run.
   explicit RunWriter(const std::filesystem::path& dir);
 
-  // For restart: opens the existing DIR/run.h5.partial and deletes the
-  // snapshots with step > last_step and any time series, so that the
-  // restarted run's file ends with the same content as an uninterrupted run's.
-  // Throws std::runtime_error if there is no partial file or it is unreadable.
+  // For restart: takes over DIR/run.h5.partial/, deleting the snapshots with
+  // step > last_step and whatever a killed process was writing (.tmp files,
+  // a half-assembled run.h5), so that the restarted run ends with the same
+  // content as an uninterrupted run's. Throws std::runtime_error naming the
+  // file if there is no partial directory, or if a snapshot it keeps (or the
+  // one at last_step, when last_step >= 0) is missing or unreadable.
   static RunWriter reopen(const std::filesystem::path& dir, long last_step);
 
   RunWriter(RunWriter&&) noexcept;
-  RunWriter& operator=(RunWriter&&) noexcept;  // the replaced writer is closed as by ~RunWriter
+  RunWriter& operator=(RunWriter&&) noexcept;
   RunWriter(const RunWriter&) = delete;
   RunWriter& operator=(const RunWriter&) = delete;
 
-  // Leaves the .partial in place (closed) unless finish() or abandon() ran.
+  // Leaves the partial directory in place unless finish() or abandon() ran.
   ~RunWriter();
 
-  // A string attribute on the file's root (resolved scene text, build and
-  // machine description); replaces an attribute of the same name.
+  // A string attribute on run.h5's root (resolved scene text, build and
+  // machine description); replaces an attribute of the same name. Kept in
+  // memory until finish(): a restart sets them again.
   void set_attribute(const std::string& name, const std::string& value);
 
-  // Writes /particles/step_<10-digit step> (and /grid/step_<...> when the
-  // snapshot carries grid data); a snapshot already present for
-  // that step is replaced. Flushed to the operating system before returning,
-  // so a checkpoint written afterwards never refers to a snapshot the
-  // partial file lacks. Throws std::invalid_argument on inconsistent sizes
-  // or bad names, std::runtime_error on HDF5 failures.
+  // Writes run.h5.partial/step_<10-digit step>.h5 (with grid data when the
+  // snapshot carries some), replacing a snapshot already written for that
+  // step: written as a .tmp file, closed (so handed to the operating
+  // system, which keeps it whatever happens to this process) and renamed
+  // into place. Throws std::invalid_argument on inconsistent sizes or bad
+  // names, std::runtime_error on HDF5 or file system failures (then no
+  // file of that step is left half-written).
   void write_snapshot(const Snapshot& snapshot);
 
-  // Writes /series (replacing it if present): columns[i] is the column
-  // called names[i]; all columns have the same length.
+  // Forces the snapshots written since the last sync() to stable storage
+  // (fsync of each file, then of the directory), so that a checkpoint
+  // written afterwards survives a machine crash with the snapshots it
+  // refers to. Called before each checkpoint rather than after each
+  // snapshot: an fsync per snapshot would tax runs that write one every
+  // few steps.
+  void sync();
+
+  // The time series run.h5's /series will hold: columns[i] is the column
+  // called names[i]; all columns have the same length. Checked now, kept in
+  // memory until finish() (replacing an earlier call's).
   void write_series(const std::vector<std::string>& names,
                     const std::vector<std::vector<double>>& columns);
 
-  // Closes the file, writes run.xdmf describing every snapshot in the file
-  // (and run_grid.xdmf for the grid snapshots, if any), calls
-  // `before_publishing` (the driver's summary.json), then renames
-  // run.h5.partial to run.h5 (atomically, synced to disk). If any of these
-  // throws, the xdmf files are removed and the partial stays.
+  // Assembles run.h5 from the snapshots, the attributes and the series,
+  // writes run.xdmf describing every snapshot (and run_grid.xdmf for the
+  // grid snapshots, if any), calls `before_publishing` (the driver's
+  // summary.json), then renames the assembled file to run.h5 (atomically,
+  // synced to disk) and removes the partial directory. If any of these but
+  // the last throws, the xdmf files are removed, run.h5 does not appear and
+  // the partial stays for a restart.
   void finish(const std::function<void()>& before_publishing = {});
 
-  // Closes and deletes the partial file: a failed run leaves nothing that
-  // looks like a result. Does nothing after finish().
+  // Deletes the partial directory: a failed run leaves nothing that looks
+  // like a result. Does nothing after finish().
   void abandon();
 
   const std::filesystem::path& directory() const { return dir_; }
   std::filesystem::path h5_path() const { return dir_ / "run.h5"; }
   std::filesystem::path partial_path() const { return dir_ / "run.h5.partial"; }
+  std::filesystem::path snapshot_path(long step) const;  // in partial_path()
   std::filesystem::path xdmf_path() const { return dir_ / "run.xdmf"; }
   std::filesystem::path grid_xdmf_path() const { return dir_ / "run_grid.xdmf"; }
 
  private:
-  RunWriter(std::filesystem::path dir, std::unique_ptr<h5::File> file);
-  bool is_open() const;
+  struct Series {
+    std::vector<std::string> names;
+    std::vector<std::vector<double>> columns;
+  };
+  RunWriter(std::filesystem::path dir, bool open);
   void require_open(const char* operation) const;
-  void close_quietly() noexcept;
 
   std::filesystem::path dir_;
-  std::unique_ptr<h5::File> file_;  // null or closed once finish() or abandon() has run
+  bool open_ = false;  // false once finish() or abandon() has run, or moved from
+  std::map<std::string, std::string> attributes_;
+  Series series_;
+  bool has_series_ = false;
+  std::vector<std::filesystem::path> unsynced_;  // snapshot files since the last sync()
 };
 
 }  // namespace mmpm::io
