@@ -59,6 +59,9 @@ struct PairBatch {
   // Pass A's stick bits + 8 × limited count as a Real: the lane loop then
   // writes only Reals (see pass_a_lanes), and a scalar loop unpacks it.
   alignas(64) Real flags[kLanes];
+  // Pass B's scratch (interface law): 1 where the stick flags stick the
+  // tangential direction, else 0 (see pass_b_lanes).
+  alignas(64) Real sticks_tangential[kLanes];
 
   // Outputs for field_a (field_b gets the negatives).
   alignas(64) Real change[D][kLanes];
@@ -372,6 +375,21 @@ template <Law L, int D, class Real>
 [[gnu::flatten]] void pass_b_lanes(PairBatch<D, Real>& B) {
   const Real friction = B.params->friction;
   const int count = B.count;
+  if constexpr (L == Law::interface) {
+    // The tangential stick flag as a 0/1 Real in memory, for the loop below
+    // to select on. A select on a test of the byte needs the byte lanes'
+    // mask converted to the double lanes', which GCC 12 for rocketlake
+    // (AVX-512 masks, 256-bit vectors) cannot do ("conversion not supported
+    // by target"; a Real made of the byte's bits in the same loop is folded
+    // back into that test, and a table is a gather it will not emit): the
+    // 2D and 3D double loops were scalar there (2026-12-01).
+    static_assert(kStickNormal == 1 && kStickTangential == 2 && kStickBoth == 4 &&
+                  kOneSidedNormal == 8);
+    for (int i = 0; i < count; ++i) {
+      const unsigned s = B.stick[i];
+      B.sticks_tangential[i] = Real(((s >> 1) | (s >> 2)) & 1u);  // tangential or both
+    }
+  }
 #pragma GCC ivdep
   for (int i = 0; i < count; ++i) {
     const VecD<D, Real> n = lane<D, Real>(B.n[0], i);
@@ -380,15 +398,16 @@ template <Law L, int D, class Real>
     const bool has_normal = dot<D, Real>(n, n) != Real(0);
     VecD<D, Real> change;
     if constexpr (L == Law::interface) {
-      const unsigned char s = B.stick[i];
       // resolve_one_sided on the updated momenta, its flags as 0/1 Reals: with
       // selects between booleans GCC 12 left the 3D float loop scalar (as in
-      // pass_a_lanes).
-      const Real stuck = (s & (kStickNormal | kStickBoth)) != 0 ? Real(1) : Real(0);
-      const Real one_sided = (s & kOneSidedNormal) != 0 ? Real(1) : Real(0);
+      // pass_a_lanes). Values made of the byte's bits, not tests of the byte
+      // (see the loop above for the tangential flag).
+      const unsigned s = B.stick[i];
+      const Real stuck = Real((s | (s >> 2)) & 1u);  // normal or both
+      const Real one_sided = Real((s >> 3) & 1u);
       const Real approaching = dot<D, Real>(dp, n) < 0 ? Real(1) : Real(0);
       const Real normal = stuck + one_sided * (approaching - stuck);
-      const Real tangential = (s & (kStickTangential | kStickBoth)) != 0 ? Real(1) : Real(0);
+      const Real tangential = B.sticks_tangential[i];
       change = stick_change_lane<D, Real>(normal != Real(0), tangential != Real(0), dp, n);
     } else {
       const bool contact = (dot<D, Real>(dp, n) < 0) & (B.dn[i] < 0);  // in_contact
