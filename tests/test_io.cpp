@@ -669,6 +669,28 @@ TEST(IoRunWriter, ReopenDeletesLaterSnapshotsAndEndsLikeAnUninterruptedRun) {
   EXPECT_EQ(between(xdmf, "<Time Value=\"", "\"/>"), (std::vector<std::string>{"0", "0.1", "0.2"}));
 }
 
+// In a forked child that is to die as a killed run does: a writer never
+// destroyed, with the snapshots of steps 0 and 7 written.
+RunWriter& leaked_writer_with_steps_0_and_7(const fs::path& dir) {
+  auto* writer = new RunWriter(dir);  // leaked on purpose: no destructor runs
+  writer->write_snapshot(make_snapshot(2, 0, 0.0 / 10, 6));
+  writer->write_snapshot(make_snapshot(2, 7, 7.0 / 10, 6));
+  return *writer;
+}
+
+// The restart of such a run from a checkpoint at step 7: it keeps steps 0
+// and 7, writes 14 and ends with all three.
+void expect_restart_from_step_7(const fs::path& dir) {
+  RunWriter writer = RunWriter::reopen(dir, 7);
+  EXPECT_EQ(steps_in(dir / "run.h5.partial"),
+            (std::vector<std::string>{"step_0000000000", "step_0000000007"}));
+  writer.write_snapshot(make_snapshot(2, 14, 14.0 / 10, 6));
+  writer.finish();
+  const RawFile file(dir / "run.h5");
+  for (long step : {0L, 7L, 14L})
+    expect_snapshot_in(file, make_snapshot(2, step, static_cast<double>(step) / 10, 6));
+}
+
 TEST(IoRunWriter, ReopenAfterTheWritingProcessWasKilled) {
   ScratchDir scratch;
   const fs::path dir = scratch.path();
@@ -677,9 +699,7 @@ TEST(IoRunWriter, ReopenAfterTheWritingProcessWasKilled) {
   if (child == 0) {
     // The child writes two snapshots and dies without closing anything.
     try {
-      auto* writer = new RunWriter(dir);  // leaked on purpose: no destructor runs
-      writer->write_snapshot(make_snapshot(2, 0, 0.0 / 10, 6));
-      writer->write_snapshot(make_snapshot(2, 7, 7.0 / 10, 6));
+      leaked_writer_with_steps_0_and_7(dir);
     } catch (...) {
       ::_exit(3);
     }
@@ -689,14 +709,7 @@ TEST(IoRunWriter, ReopenAfterTheWritingProcessWasKilled) {
   ASSERT_EQ(::waitpid(child, &status, 0), child);
   ASSERT_TRUE(WIFEXITED(status));
   ASSERT_EQ(WEXITSTATUS(status), 0);
-
-  RunWriter writer = RunWriter::reopen(dir, 7);
-  writer.write_snapshot(make_snapshot(2, 14, 14.0 / 10, 6));
-  writer.finish();
-  const RawFile file(dir / "run.h5");
-  for (long step : {0L, 7L, 14L}) {
-    expect_snapshot_in(file, make_snapshot(2, step, static_cast<double>(step) / 10, 6));
-  }
+  expect_restart_from_step_7(dir);
 }
 
 // What a kill in the middle of a write leaves: a snapshot's .tmp file cut
@@ -717,12 +730,13 @@ TEST(IoRunWriter, ReopenDropsWhatAKilledWriteLeft) {
   fs::resize_file(partial / "run.h5", 900);
 
   RunWriter writer = RunWriter::reopen(dir, 20);
-  EXPECT_EQ(steps_in(partial), (std::vector<std::string>{"step_0000000000", "step_0000000010",
-                                                         "step_0000000020"}));
+  EXPECT_EQ(steps_in(partial),
+            (std::vector<std::string>{"step_0000000000", "step_0000000010", "step_0000000020"}));
   writer.write_snapshot(make_snapshot(2, 30, 0.01 * 30, 5));
   writer.finish();
   const RawFile file(dir / "run.h5");
-  for (long step : {0L, 10L, 20L, 30L}) expect_snapshot_in(file, make_snapshot(2, step, 0.01 * step, 5));
+  for (long step : {0L, 10L, 20L, 30L})
+    expect_snapshot_in(file, make_snapshot(2, step, 0.01 * step, 5));
   EXPECT_FALSE(fs::exists(partial));
 }
 
@@ -741,10 +755,8 @@ TEST(IoRunWriter, ReopenAfterAKillDuringASnapshotWrite) {
   ASSERT_GE(child, 0);
   if (child == 0) {
     try {
-      auto* writer = new RunWriter(dir);  // leaked on purpose: no destructor runs
-      writer->write_snapshot(make_snapshot(2, 0, 0.0 / 10, 6));
-      writer->write_snapshot(make_snapshot(2, 7, 7.0 / 10, 6));
-      for (;;) writer->write_snapshot(large);  // until killed
+      RunWriter& writer = leaked_writer_with_steps_0_and_7(dir);
+      for (;;) writer.write_snapshot(large);  // until killed
     } catch (...) {
       ::_exit(3);
     }
@@ -758,15 +770,7 @@ TEST(IoRunWriter, ReopenAfterAKillDuringASnapshotWrite) {
   ASSERT_EQ(::waitpid(child, &status, 0), child);
   ASSERT_TRUE(WIFSIGNALED(status)) << "the writer ended by itself, status " << status;
   EXPECT_TRUE(fs::exists(big)) << "the kill fell between two writes, not in one";
-
-  RunWriter writer = RunWriter::reopen(dir, 7);
-  EXPECT_EQ(steps_in(dir / "run.h5.partial"),
-            (std::vector<std::string>{"step_0000000000", "step_0000000007"}));
-  writer.write_snapshot(make_snapshot(2, 14, 14.0 / 10, 6));
-  writer.finish();
-  const RawFile file(dir / "run.h5");
-  for (long step : {0L, 7L, 14L})
-    expect_snapshot_in(file, make_snapshot(2, step, static_cast<double>(step) / 10, 6));
+  expect_restart_from_step_7(dir);
 }
 
 // A snapshot write that fails (a full disk; here a file size limit with
@@ -792,7 +796,7 @@ TEST(IoRunWriter, FailedSnapshotWriteLeavesNoFile) {
     }
     try {
       writer->write_snapshot(make_snapshot(2, 5, 0.5, 20'000));  // 2.6 MB of values
-      ::_exit(12);  // the limit did not bite
+      ::_exit(12);                                               // the limit did not bite
     } catch (const std::runtime_error& e) {
       const std::string what = e.what();
       const bool named = what.find((dir / "run.h5.partial" / "step_0000000005.h5.tmp").string()) !=
