@@ -818,6 +818,31 @@ TEST(IoRunWriter, FailedSnapshotWriteLeavesNoFile) {
   expect_snapshot_in(file, make_snapshot(2, 5, 0.5, 6));
 }
 
+// A snapshot file damaged under a running writer: finish() names that
+// file (not run.h5, which it was writing), publishes nothing and leaves
+// the partial for a restart.
+TEST(IoRunWriter, FinishNamesTheDamagedSnapshotFile) {
+  ScratchDir scratch;
+  const fs::path dir = scratch.path();
+  RunWriter writer(dir);
+  writer.write_snapshot(make_snapshot(2, 0, 0.0, 5));
+  writer.write_snapshot(make_snapshot(2, 5, 0.5, 5));
+  const fs::path damaged = dir / "run.h5.partial" / "step_0000000005.h5";
+  fs::resize_file(damaged, 600);
+  try {
+    writer.finish();
+    ADD_FAILURE() << "finish() accepted a damaged snapshot";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find(damaged.string()), std::string::npos) << what;
+    EXPECT_EQ(what.find("run.h5.partial/run.h5"), std::string::npos) << what;
+  }
+  EXPECT_FALSE(fs::exists(dir / "run.h5"));
+  EXPECT_FALSE(fs::exists(dir / "run.xdmf"));
+  EXPECT_FALSE(fs::exists(dir / "run.h5.partial" / "run.h5"));
+  EXPECT_TRUE(fs::exists(dir / "run.h5.partial" / "step_0000000000.h5"));
+}
+
 // A snapshot the restart keeps that is damaged, or the checkpoint's last
 // one missing: refused at once, naming the file.
 TEST(IoRunWriter, ReopenRefusesDamagedOrMissingSnapshots) {

@@ -362,17 +362,19 @@ void copy_dataset(const h5::Group& from, const fs::path& source, h5::Group& to,
 void copy_snapshot(const h5::Group& snapshot_root, const fs::path& source, h5::Group& run_root,
                    const fs::path& target) {
   for (const char* group_name : snapshot_groups) {
-    bool present = false;
-    naming(source, [&] { present = snapshot_root.contains(group_name); });
-    if (!present) continue;
-    const h5::Group from = snapshot_root.open_group(group_name);
+    std::optional<h5::Group> from;
     std::vector<std::string> children;
-    naming(source, [&] { children = from.children(); });
+    naming(source, [&] {
+      if (!snapshot_root.contains(group_name)) return;
+      from.emplace(snapshot_root.open_group(group_name));
+      children = from->children();
+    });
+    if (!from) continue;
     h5::Group to = run_root.require_group(group_name);
     for (const std::string& child : children) {
       if (to.contains(child)) continue;
       if (parse_step_name(child) < 0) {
-        copy_dataset(from, source, to, target, child);
+        copy_dataset(*from, source, to, target, child);
         continue;
       }
       std::optional<std::int64_t> step;
@@ -380,7 +382,7 @@ void copy_snapshot(const h5::Group& snapshot_root, const fs::path& source, h5::G
       std::vector<std::string> fields;
       std::optional<h5::Group> group;
       naming(source, [&] {
-        group.emplace(from.open_group(child));
+        group.emplace(from->open_group(child));
         if (group->has_attribute("step")) step = group->int_attribute("step");
         if (group->has_attribute("time")) time = group->double_attribute("time");
         fields = group->children();
