@@ -82,8 +82,26 @@ def load(path):
 
 
 class Results:
-    def __init__(self, runs):
+    def __init__(self, runs, context=None):
         self.runs = runs
+        self.context = context or {}
+
+    def caches(self):
+        """'48 KiB L1d and 2 MiB L2 per core, 480 MiB L3 shared', from the
+        caches Google Benchmark read off this machine (the text named one
+        host's caches until 2026-12-01, wrong on the others)."""
+        def size(b):
+            return f"{b // 1048576} MiB" if b >= 1048576 else f"{b // 1024} KiB"
+        found = {}
+        for c in self.context.get("caches", []):
+            if c.get("type") in ("Data", "Unified"):
+                found[c["level"]] = (c["size"], c.get("num_sharing", 1))
+        if 1 not in found or 2 not in found:
+            return "caches not recorded"
+        text = f"{size(found[1][0])} L1d and {size(found[2][0])} L2 per core"
+        if 3 in found:
+            text += f", {size(found[3][0])} L3" + (" shared" if found[3][1] > 1 else " per core")
+        return text
 
     def find(self, family, **want):
         """The run of `family` whose name has exactly these key:value items."""
@@ -633,8 +651,8 @@ def scaling_section(R):
     out = ["## 7. Problem size: 10^4 to 10^7 particles (2D linear, whole step, ns/particle/step)", "",
            "The `2d_linear_1mat` scene (MUSL) with a square block of N particles (2 × 2 per cell). "
            "grid MiB = nodes × 9 arrays × 8 bytes, particle MiB = N × 16 arrays × 8 bytes "
-           "(what the step touches; 20 before L left the particle arrays on 2026-11-26). This machine: 48 KiB L1d and 1 MiB L2 per core, 32 MiB L3 "
-           "shared.", ""]
+           "(what the step touches; 20 before L left the particle arrays on 2026-11-26). "
+           f"This machine: {R.caches()} (as Google Benchmark read them).", ""]
     header = ["particles", "grid MiB", "particle MiB", "1 thread", "2 threads", "speed-up",
               "p2g (1t)", "g2p (1t)", "grid (1t)", "constitutive (1t)"]
     rows = []
@@ -825,7 +843,7 @@ def main():
         return
 
     context, runs, errors = load(args.json)
-    R = Results(runs)
+    R = Results(runs, context)
     model, cpus = lscpu_model()
     commit = context.get("git_commit") or git_commit(os.path.dirname(here))
     date = context.get("date") or datetime.datetime.now().isoformat(timespec="seconds")
