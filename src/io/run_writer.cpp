@@ -1,6 +1,5 @@
 #include "io/run_writer.hpp"
 
-#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <initializer_list>
@@ -424,15 +423,13 @@ std::map<long, fs::path> snapshot_files(const fs::path& partial) {
 // A snapshot file a restart keeps must open and hold its snapshot: a
 // damaged one is refused at the restart, not found at the run's end.
 void check_snapshot_file(const fs::path& file, long step) {
-  try {
+  naming(file, [&] {
     const h5::File in = h5::File::open(file, h5::File::Mode::read_only);
     const h5::Group root = in.root();
     if (!root.contains(particles_group) ||
         !root.open_group(particles_group).contains(step_name(step)))
       throw std::runtime_error("holds no snapshot of step " + std::to_string(step));
-  } catch (...) {
-    rethrow_naming(file);
-  }
+  });
 }
 
 }  // namespace
@@ -485,7 +482,6 @@ RunWriter::RunWriter(RunWriter&& other) noexcept
       open_(std::exchange(other.open_, false)),
       attributes_(std::move(other.attributes_)),
       series_(std::move(other.series_)),
-      has_series_(other.has_series_),
       unsynced_(std::move(other.unsynced_)) {}
 
 RunWriter& RunWriter::operator=(RunWriter&& other) noexcept {
@@ -494,7 +490,6 @@ RunWriter& RunWriter::operator=(RunWriter&& other) noexcept {
     open_ = std::exchange(other.open_, false);
     attributes_ = std::move(other.attributes_);
     series_ = std::move(other.series_);
-    has_series_ = other.has_series_;
     unsynced_ = std::move(other.unsynced_);
   }
   return *this;
@@ -537,8 +532,7 @@ void RunWriter::write_snapshot(const Snapshot& snapshot) {
     fs::remove(tmp, ignored);
     rethrow_naming(tmp);
   }
-  if (std::find(unsynced_.begin(), unsynced_.end(), file) == unsynced_.end())
-    unsynced_.push_back(file);
+  unsynced_.insert(file);
 }
 
 void RunWriter::sync() {
@@ -569,7 +563,6 @@ void RunWriter::write_series(const std::vector<std::string>& names,
     }
   }
   series_ = Series{names, columns};
-  has_series_ = true;
 }
 
 void RunWriter::finish(const std::function<void()>& before_publishing) {
@@ -593,7 +586,7 @@ void RunWriter::finish(const std::function<void()>& before_publishing) {
         });
         copy_snapshot(*in_root, file, root, assembled);
       }
-      if (has_series_) write_series_group(root, series_.names, series_.columns);
+      if (series_) write_series_group(root, series_->names, series_->columns);
       const std::vector<XdmfSnapshot> snapshots = describe(root);
       write_vertex_ids(root, snapshots);
       document = xdmf_document("run.h5", snapshots);

@@ -37,6 +37,8 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -150,9 +152,8 @@ class RunWriter {
   std::filesystem::path dir_;
   bool open_ = false;  // false once finish() or abandon() has run, or moved from
   std::map<std::string, std::string> attributes_;
-  Series series_;
-  bool has_series_ = false;
-  std::vector<std::filesystem::path> unsynced_;  // snapshot files since the last sync()
+  std::optional<Series> series_;              // none until write_series()
+  std::set<std::filesystem::path> unsynced_;  // snapshot files since the last sync()
 };
 
 }  // namespace mmpm::io
