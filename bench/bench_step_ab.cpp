@@ -71,7 +71,8 @@ void register_step_ab() {
   // plain tile order instead of color by color; skip_empty_nodes: the node
   // passes over every node of every field; tile: another tile edge;
   // prefetch_grid: the 2D transfers without the grid lines requested a line
-  // ahead; same_settings: B as A (the control).
+  // ahead; prefetch_particles: the transfers without the particle columns
+  // requested a batch ahead; same_settings: B as A (the control).
   const std::pair<const char*, const char*> settings[] = {
       {"fuse_step_tail_false", "simulation.fuse_step_tail=false"},
       {"particle_order_tile", "simulation.particle_order=\"tile\""},
@@ -79,6 +80,7 @@ void register_step_ab() {
       {"tile_32", "grid.tile=32"},
       {"tile_16", "grid.tile=16"},
       {"prefetch_grid_false", "simulation.prefetch_grid=false"},
+      {"prefetch_particles_false", "simulation.prefetch_particles=false"},
       {"same_settings", ""}};
   for (const auto& [label, override_b] : settings)
     for (const char* scene : {"2d_linear_1mat", "2d_gimp_interface", "2d_gimp_inclusions",
@@ -88,12 +90,15 @@ void register_step_ab() {
         // there for; the tile edge the other way from the default: 32 on
         // the 254^2 grids, whose default is 16, 16 on the 10^6 block's
         // 504^2 grid, whose default is 32 (Stepper::setup_grid); not in 3D.
-        // The prefetch (2D only) on the 10^6 block too, where the grid has
-        // left the caches.
+        // The grid prefetch (2D only) and the particle prefetch on the 10^6
+        // block too, where the grid and the particles have left the caches.
         const std::string sc = scene, lb = label;
         if (lb != "same_settings") {
           if (sc == "2d_linear_room" && lb != "skip_empty_nodes_false") continue;
-          if (sc == "2d_linear_1e6" && lb != "tile_16" && lb != "prefetch_grid_false") continue;
+          if (sc == "2d_linear_1e6" && lb != "tile_16" && lb != "prefetch_grid_false" &&
+              lb != "prefetch_particles_false")
+            continue;
+          if (lb == "prefetch_particles_false" && sc == "2d_linear_room") continue;
           if (lb == "prefetch_grid_false" && (sc == "3d_gimp_1mat" || sc == "2d_linear_room"))
             continue;
           if (lb == "tile_16" && sc != "2d_linear_1e6") continue;

@@ -532,6 +532,11 @@ PAIRED_SETTINGS = [
      "(B: prefetch_grid = false)",
      "A with the defaults (the 2D transfers request the grid lines their windows reach next, on "
      "grids of 1 MiB and more) and B without the requests", "the requests are faster", "g2p"),
+    ("prefetch_particles_false", "Particle columns requested ahead, paired blocks "
+     "(B: prefetch_particles = false)",
+     "A with the defaults (the transfers request the particle columns they stream a batch "
+     "ahead, when those columns take 4 MiB and more) and B without the requests",
+     "the requests are faster", "g2p"),
     ("same_settings", "Control: two Simulations with the same settings, paired blocks",
      "A and B both with the defaults (B made after A): what the harness itself puts between two "
      "equal runs, the scale against which the rows above are read", "A is slower", "g2p"),

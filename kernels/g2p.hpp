@@ -386,6 +386,7 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
   std::conditional_t<kPairs, Gathered, NoGathered> gathered;
   auto build = [&](std::size_t first, std::size_t n, Weights * w, bool* ok)
       __attribute__((always_inline)) {
+    if (q.particles_ahead) q.particles_ahead->batch(first, n);
     st.build_batch(P, first, n, w, ok);
     if constexpr (Windowed)
       ahead.batch(n, [&](std::size_t i) {

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <type_traits>
 
+#include "kernels/particle_prefetch.hpp"
 #include "kernels/particle_view.hpp"
 #include "kernels/position_sum.hpp"
 
@@ -29,6 +30,15 @@ enum G2PWhat : unsigned {
   kStressUpdate = 16u,
 };
 
+// The particle columns a G2P pass of `what` streams (kernels/particle_prefetch.hpp).
+constexpr unsigned g2p_streams(unsigned what) {
+  return ((what & kUpdateMotion) ? unsigned(kStreamMotion) : 0u) |
+         ((what & kScatterMomentum) ? unsigned(kStreamMomentum) : 0u) |
+         ((what & kVelocityGradient) ? unsigned(kStreamGradient) : 0u) |
+         ((what & kCommitPosition) ? unsigned(kStreamCommit) : 0u) |
+         ((what & kStressUpdate) ? unsigned(kStreamConstitutive) : 0u);
+}
+
 struct G2PParams {
   double dt = 0;
   double flip = 1;
@@ -36,6 +46,8 @@ struct G2PParams {
   const double (*rigid_velocity)[3] = nullptr;  // per field, at t + dt
   double body_accel[3] = {0, 0, 0};             // for the external work of gravity
   bool prefetch_grid = true;  // 2D: the grid lines a line ahead (kernels/grid_prefetch.hpp)
+  // The particle columns a batch ahead (kernels/particle_prefetch.hpp); null: none.
+  const ParticleLinesAhead* particles_ahead = nullptr;
 };
 
 // Outcome of a G2P range: first bad particle (stencil off the grid or

@@ -104,6 +104,7 @@ std::size_t p2g_range_grouped(const ParticleView<D, Real>& particles, const Grid
   for (std::size_t first = begin; first < end; first += kWeightBatch) {
     const std::size_t n = std::min(kWeightBatch, end - first);
     bool inside[kWeightBatch];
+    if (opt.particles_ahead) opt.particles_ahead->batch(first, n);
     builder.build_batch(P, first, n, w, inside);
     std::size_t ok = 0;
     while (ok < n && inside[ok]) ++ok;
@@ -138,6 +139,7 @@ std::size_t p2g_range_one_block(const ParticleView<D, Real>& particles,
   auto ahead = scatter_lines_ahead<What, Win>(opt.prefetch_grid, off, G);
   auto build = [&](std::size_t first, std::size_t n, Win * w, bool* ok)
       __attribute__((always_inline)) {
+    if (opt.particles_ahead) opt.particles_ahead->batch(first, n);
     builder.build_batch(P, first, n, w, ok);
     ahead.batch(n, [&](std::size_t i) {
       return ok[i] ? w[i].base + field_offset<MultiField>(P, G, first + i) : SIZE_MAX;

@@ -195,8 +195,10 @@ std::size_t p2g_range_packed(const ParticleView<2, Real>& particles, const GridV
   const Real inv_hx = builder.inverse_spacing(0), inv_hy = builder.inverse_spacing(1);
   PackedBatch<Real, K, MultiField> batch;
   Block carried;  // current == SIZE_MAX: nothing carried
+  const ParticleLinesAhead* const columns_ahead = opt.particles_ahead;
   for (std::size_t first = begin; first < end; first += kWeightBatch) {
     const std::size_t n = std::min(kWeightBatch, end - first);
+    if (columns_ahead) columns_ahead->batch(first, n);
     batch.locate(builder, P, first, n);
     for (std::size_t i = 0; i < n;) {
       if (!batch.inside[i]) {

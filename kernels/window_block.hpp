@@ -7,6 +7,7 @@
 #include <cstdint>
 
 #include "kernels/grid_view.hpp"
+#include "kernels/particle_prefetch.hpp"
 #include "kernels/particle_view.hpp"
 #include "kernels/position_sum.hpp"
 #include "kernels/weight_batch.hpp"
@@ -27,6 +28,8 @@ struct P2GOptions {
   bool position_separation = false;  // mx holds positions (else displacements)
   double inv_thickness = 1.0;        // 2D: Omega and g are areas (P-19, P-33)
   bool prefetch_grid = true;         // 2D: the grid lines a line ahead (kernels/grid_prefetch.hpp)
+  // The particle columns a batch ahead (kernels/particle_prefetch.hpp); null: none.
+  const ParticleLinesAhead* particles_ahead = nullptr;
 };
 
 // The per-particle factors a transfer scatters (ALGORITHM §1-2).

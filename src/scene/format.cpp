@@ -129,6 +129,7 @@ void write_simulation(Writer& w, const Scene& s) {
   // scene a checkpoint stores, run_driver.cpp) stays equal to its
   // re-resolved self.
   if (!sim.prefetch_grid) w.boolean("prefetch_grid", false);
+  if (!sim.prefetch_particles) w.boolean("prefetch_particles", false);
   w.word("particle_order", sim.particle_order);
   w.boolean("compensated_positions", sim.compensated_positions);
   w.num("mm_fields_share", sim.mm_fields_share);

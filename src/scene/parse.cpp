@@ -708,7 +708,8 @@ class SceneReader {
             "mm_fields_share",
             "particle_order",
             "skip_empty_nodes",
-            "prefetch_grid"});
+            "prefetch_grid",
+            "prefetch_particles"});
     SimulationSpec& sim = scene_.simulation;
     const Field d = t.need("dimension");
     const long long dimension = d.integer();
@@ -751,6 +752,7 @@ class SceneReader {
     if (auto f = t.get("fuse_step_tail")) sim.fuse_step_tail = f->boolean();
     if (auto f = t.get("skip_empty_nodes")) sim.skip_empty_nodes = f->boolean();
     if (auto f = t.get("prefetch_grid")) sim.prefetch_grid = f->boolean();
+    if (auto f = t.get("prefetch_particles")) sim.prefetch_particles = f->boolean();
     if (auto f = t.get("particle_order")) sim.particle_order = f->choice(kParticleOrderNames);
     if (auto f = t.get("mm_fields_share")) {
       sim.mm_fields_share = f->number();

@@ -79,6 +79,10 @@ struct SimulationSpec {
   // ahead in x; same results, bitwise (kernels/grid_prefetch.hpp,
   // docs/performance.md "Grid lines a line ahead"). false: no requests.
   bool prefetch_grid = true;
+  // The transfers request the particle columns they stream a batch ahead;
+  // same results, bitwise (kernels/particle_prefetch.hpp, docs/performance.md
+  // "Particle columns requested ahead"). false: no requests.
+  bool prefetch_particles = true;
   // How the particles are stored between sorts: tile by tile, color by color
   // (each colored pass reads its particles front to back), or in plain tile
   // order. Same results but for the order of sums over particles

@@ -86,6 +86,12 @@ class Stepper final : public Simulation {
   const NodeOwnership& ownership() const { return own_; }
   // Whether the 2D transfers request grid lines ahead (stepper_impl.hpp).
   bool prefetch_grid() const;
+  // The particle columns a pass of `streams` requests ahead
+  // (kernels/particle_prefetch.hpp; nothing when prefetch_particles is off).
+  ParticleLinesAhead particles_ahead(unsigned streams, bool L_in_columns = true) const;
+  // For tests: request from this many bytes of a pass's columns on
+  // (default kPrefetchMinParticleBytes), so small scenes take the requests.
+  void set_prefetch_min_particle_bytes(std::size_t bytes) { prefetch_min_particle_bytes_ = bytes; }
   // For tests: the shortest gap the node runs skip (kernels/active_nodes.hpp,
   // kMinSkippedNodes), from the next re-sort on, which this asks for.
   void set_min_skipped_nodes(std::size_t n) {
@@ -224,6 +230,7 @@ class Stepper final : public Simulation {
   std::array<StaggeredArray<Real>, D * D> L_;
   // MUSL's end-of-step positions, staggered like the particle columns (4 KiB aliasing)
   std::array<StaggeredArray<Real>, D> x_next_;
+  std::size_t prefetch_min_particle_bytes_ = kPrefetchMinParticleBytes;
   std::vector<std::uint32_t> perm_, offsets_, scratch_keys_;
   // The fused tail's L of one tile per thread (fused_step_tail): the
   // velocity gradient lives from the tile's G2P to its constitutive update

@@ -337,8 +337,14 @@ void Stepper<D, Shape, Real>::fused_step_tail() {
   isotropic_table_.dt = Real(dt_);  // as in constitutive()
   const bool mm = plan_.multimaterial;
   zero_grid(mm);
-  const G2PParams q = g2p_params();
+  G2PParams q = g2p_params();
   const P2GOptions opt = p2g_options();
+  // The gradient pass requests the columns of all three stages: the
+  // constitutive update and P2G then find them in the cache.
+  const ParticleLinesAhead ahead = particles_ahead(
+      g2p_streams(kCommitPosition | kVelocityGradient) | kStreamConstitutive | kStreamScatter,
+      false);
+  q.particles_ahead = &ahead;
   const bool with_mm = mm && mm_fields_with_p2g_;  // what the next step's P2G scatters
   std::vector<G2PRangeResult> res(tiles_.tile_count);
   std::atomic<std::size_t> first_bad{SIZE_MAX}, first_unsound{SIZE_MAX};
@@ -527,6 +533,19 @@ bool Stepper<D, Shape, Real>::prefetch_grid() const {
   return scene_.simulation.prefetch_grid && bytes >= kPrefetchMinGridBytes;
 }
 
+// The particle columns a pass requests ahead (kernels/particle_prefetch.hpp):
+// [simulation] prefetch_particles, when the pass's columns take
+// kPrefetchMinParticleBytes or more (smaller ones stay in the caches, where
+// the requests only cost).
+template <int D, class Shape, class Real>
+ParticleLinesAhead Stepper<D, Shape, Real>::particles_ahead(unsigned streams,
+                                                            bool L_in_columns) const {
+  if (!scene_.simulation.prefetch_particles) return {};
+  ParticleLinesAhead ahead(P_, streams, L_in_columns);
+  if (P_.n * ahead.bytes_per_particle() < prefetch_min_particle_bytes_) return {};
+  return ahead;
+}
+
 template <int D, class Shape, class Real>
 P2GOptions Stepper<D, Shape, Real>::p2g_options() const {
   P2GOptions opt;
@@ -551,7 +570,9 @@ std::size_t Stepper<D, Shape, Real>::p2g_tile(const P2GOptions& opt, std::size_t
 template <int D, class Shape, class Real>
 template <unsigned What>
 void Stepper<D, Shape, Real>::p2g(const char* label) {
-  const P2GOptions opt = p2g_options();
+  P2GOptions opt = p2g_options();
+  const ParticleLinesAhead ahead = particles_ahead(kStreamScatter);
+  opt.particles_ahead = &ahead;
   std::atomic<std::size_t> first_bad{SIZE_MAX};
   for (std::size_t c = 0; c < schedule_.tiles.size(); ++c) {
     if (schedule_.tiles[c].empty()) continue;
@@ -650,7 +671,9 @@ void Stepper<D, Shape, Real>::collect(const std::vector<G2PRangeResult>& res) {
 template <int D, class Shape, class Real>
 template <unsigned What>
 void Stepper<D, Shape, Real>::g2p() {
-  const G2PParams q = g2p_params();
+  G2PParams q = g2p_params();
+  const ParticleLinesAhead ahead = particles_ahead(g2p_streams(What));
+  q.particles_ahead = &ahead;
   const std::size_t n = P_.n, chunks = chunk_count(n);
   std::vector<G2PRangeResult> res(chunks);
   // Fixed chunks (the external work sums in chunk order whatever the
@@ -671,7 +694,9 @@ void Stepper<D, Shape, Real>::g2p() {
 template <int D, class Shape, class Real>
 template <unsigned What>
 void Stepper<D, Shape, Real>::g2p_colored() {
-  const G2PParams q = g2p_params();
+  G2PParams q = g2p_params();
+  const ParticleLinesAhead ahead = particles_ahead(g2p_streams(What));
+  q.particles_ahead = &ahead;
   std::vector<G2PRangeResult> res(tiles_.tile_count);
   for (std::size_t c = 0; c < schedule_.tiles.size(); ++c) {
     if (schedule_.tiles[c].empty()) continue;
