@@ -98,7 +98,8 @@ void register_step_ab() {
           if (sc == "2d_linear_1e6" && lb != "tile_16" && lb != "prefetch_grid_false" &&
               lb != "prefetch_particles_false")
             continue;
-          if (lb == "prefetch_particles_false" && sc == "2d_linear_room") continue;
+          if (lb == "prefetch_particles_false" && (sc == "3d_gimp_1mat" || sc == "2d_linear_room"))
+            continue;
           if (lb == "prefetch_grid_false" && (sc == "3d_gimp_1mat" || sc == "2d_linear_room"))
             continue;
           if (lb == "tile_16" && sc != "2d_linear_1e6") continue;

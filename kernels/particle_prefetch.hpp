@@ -1,5 +1,6 @@
 // Software prefetch of the particle columns a pass streams, a fixed number
-// of particles ahead ([simulation] prefetch_particles, default on).
+// of particles ahead ([simulation] prefetch_particles, default on; the
+// solver requests in 2D only, Stepper::particles_ahead).
 //
 // Why: a transfer pass streams 8-16 particle columns (x, v, m, V, sigma,
 // x_next, ...) beside the short grid row pieces of its windows. Once the
@@ -7,7 +8,7 @@
 // (Xeon, 2 MiB L2 per core) did not keep that many streams ahead: the 2D
 // linear step read 40.2 ns/particle-step at 3*10^6 particles against 26.3
 // at 3*10^5 on one thread. Requesting every column's lines kAhead particles
-// ahead, one batch at a time, brought it to 33.5 (docs/performance.md
+// ahead, one batch at a time, brought it to 33.5-35.3 (docs/performance.md
 // "Particle columns requested ahead"). A request is a hint: no value
 // changes, and a line past a column's end is never requested.
 #pragma once
