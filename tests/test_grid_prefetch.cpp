@@ -10,13 +10,11 @@
 // scene resolved before it existed (a checkpoint's) re-resolves to the same
 // text.
 #include <gtest/gtest.h>
-#include <omp.h>
 
 #include <memory>
 #include <string>
 #include <vector>
 
-#include "bitwise_same.hpp"
 #include "kernels/grid_prefetch.hpp"
 #include "kernels/shape.hpp"
 #include "kernels/window.hpp"
@@ -24,11 +22,11 @@
 #include "scene/parse.hpp"
 #include "solver/simulation.hpp"
 #include "solver/stepper.hpp"
+#include "switch_checks.hpp"
 
 namespace {
 
 using namespace mmpm;
-using mmpm::testing::expect_bitwise_same;
 
 const std::string kInputs = std::string(MMPM_SOURCE_DIR) + "/inputs/";
 
@@ -39,21 +37,10 @@ std::unique_ptr<Simulation> make(const std::string& file, std::vector<std::strin
 
 void expect_same_with_and_without(const std::string& file, const std::vector<std::string>& sets,
                                   int steps) {
-  const int saved = omp_get_max_threads();
-  for (int threads : {1, 2}) {
-    omp_set_num_threads(threads);
-    const std::string what =
-        file + " " + ::testing::PrintToString(sets) + ", " + std::to_string(threads) + " thread(s)";
-    auto on = make(file, sets, true), off = make(file, sets, false);
-    for (int s = 1; s <= steps; ++s) {
-      on->step();
-      off->step();
-      if (s % 10 == 0 || s == steps)
-        expect_bitwise_same(*on, *off, what + ", step " + std::to_string(s));
-      if (::testing::Test::HasFailure()) break;
-    }
-  }
-  omp_set_num_threads(saved);
+  mmpm_test::expect_switch_changes_nothing(
+      file + " " + ::testing::PrintToString(sets), steps, [&](const std::string&) {
+        return mmpm_test::SimulationPair(make(file, sets, true), make(file, sets, false));
+      });
 }
 
 TEST(GridPrefetch, TwoLayerInterfaceBitwise) {
@@ -92,15 +79,8 @@ TEST(GridPrefetch, OnlyOnGridsPastTheL2) {
 }
 
 TEST(GridPrefetch, WrittenBackOnlyWhenOff) {
-  const Scene on = parse_scene_file(kInputs + "two_layer.toml", {});
-  EXPECT_TRUE(on.simulation.prefetch_grid);
-  EXPECT_EQ(format_scene(on).find("prefetch_grid"), std::string::npos);
-  const Scene off =
-      parse_scene_file(kInputs + "two_layer.toml", {"simulation.prefetch_grid=false"});
-  EXPECT_FALSE(off.simulation.prefetch_grid);
-  const std::string text = format_scene(off);
-  EXPECT_NE(text.find("prefetch_grid = false"), std::string::npos) << text;
-  EXPECT_FALSE(parse_scene_text(text, "resolved.toml", {}).simulation.prefetch_grid);
+  mmpm_test::expect_written_back_only_when_off(kInputs + "two_layer.toml", "prefetch_grid",
+                                               &SimulationSpec::prefetch_grid);
 }
 
 TEST(GridPrefetch, OnlyIn2D) {

@@ -8,14 +8,12 @@
 // kPrefetchMinParticleBytes or more; these scenes are smaller, so their
 // steppers are told to request from 0 bytes on.
 #include <gtest/gtest.h>
-#include <omp.h>
 
 #include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
 
-#include "bitwise_same.hpp"
 #include "kernels/g2p_particle.hpp"
 #include "kernels/particle_prefetch.hpp"
 #include "kernels/shape.hpp"
@@ -23,11 +21,11 @@
 #include "scene/parse.hpp"
 #include "solver/simulation.hpp"
 #include "solver/stepper.hpp"
+#include "switch_checks.hpp"
 
 namespace {
 
 using namespace mmpm;
-using mmpm::testing::expect_bitwise_same;
 
 const std::string kInputs = std::string(MMPM_SOURCE_DIR) + "/inputs/";
 
@@ -43,28 +41,20 @@ Stepper<D, Shape, Real>* request_always(Simulation& sim) {
 template <int D, class Shape, class Real>
 void expect_same_with_and_without(const std::string& file, const std::vector<std::string>& sets,
                                   int steps) {
-  const int saved = omp_get_max_threads();
-  for (int threads : {1, 2}) {
-    omp_set_num_threads(threads);
-    const std::string what =
-        file + " " + ::testing::PrintToString(sets) + ", " + std::to_string(threads) + " thread(s)";
-    std::vector<std::string> off_sets = sets;
-    off_sets.push_back("simulation.prefetch_particles=false");
-    auto on = make_simulation(parse_scene_file(kInputs + file, sets));
-    auto off = make_simulation(parse_scene_file(kInputs + file, off_sets));
-    auto* stepper = request_always<D, Shape, Real>(*on);
-    ASSERT_NE(stepper, nullptr) << what << ": not the instantiation the test means";
-    // Every pass of the scene requests (the columns are there from the start).
-    ASSERT_TRUE(stepper->particles_ahead(kStreamScatter).on()) << what;
-    for (int s = 1; s <= steps; ++s) {
-      on->step();
-      off->step();
-      if (s % 10 == 0 || s == steps)
-        expect_bitwise_same(*on, *off, what + ", step " + std::to_string(s));
-      if (::testing::Test::HasFailure()) break;
-    }
-  }
-  omp_set_num_threads(saved);
+  std::vector<std::string> off_sets = sets;
+  off_sets.push_back("simulation.prefetch_particles=false");
+  mmpm_test::expect_switch_changes_nothing(
+      file + " " + ::testing::PrintToString(sets), steps, [&](const std::string& what) {
+        mmpm_test::SimulationPair sims(make_simulation(parse_scene_file(kInputs + file, sets)),
+                                       make_simulation(parse_scene_file(kInputs + file, off_sets)));
+        auto* stepper = request_always<D, Shape, Real>(*sims.first);
+        // Every pass of the scene requests (its columns exist from the start).
+        if (!stepper || !stepper->particles_ahead(kStreamScatter).on()) {
+          ADD_FAILURE() << what << ": not the instantiation the test means, or no requests";
+          sims.first.reset();
+        }
+        return sims;
+      });
 }
 
 TEST(ParticlePrefetch, TwoLayerInterfaceBitwise) {
@@ -124,15 +114,8 @@ TEST(ParticlePrefetch, OnlyPastTheThreshold) {
 }
 
 TEST(ParticlePrefetch, WrittenBackOnlyWhenOff) {
-  const Scene on = parse_scene_file(kInputs + "two_layer.toml", {});
-  EXPECT_TRUE(on.simulation.prefetch_particles);
-  EXPECT_EQ(format_scene(on).find("prefetch_particles"), std::string::npos);
-  const Scene off =
-      parse_scene_file(kInputs + "two_layer.toml", {"simulation.prefetch_particles=false"});
-  EXPECT_FALSE(off.simulation.prefetch_particles);
-  const std::string text = format_scene(off);
-  EXPECT_NE(text.find("prefetch_particles = false"), std::string::npos) << text;
-  EXPECT_FALSE(parse_scene_text(text, "resolved.toml", {}).simulation.prefetch_particles);
+  mmpm_test::expect_written_back_only_when_off(kInputs + "two_layer.toml", "prefetch_particles",
+                                               &SimulationSpec::prefetch_particles);
 }
 
 // The columns of each pass, from a view whose columns are distinct fake
