@@ -95,13 +95,9 @@ void register_step_ab() {
         const std::string sc = scene, lb = label;
         if (lb != "same_settings") {
           if (sc == "2d_linear_room" && lb != "skip_empty_nodes_false") continue;
-          if (sc == "2d_linear_1e6" && lb != "tile_16" && lb != "prefetch_grid_false" &&
-              lb != "prefetch_particles_false")
-            continue;
-          if (lb == "prefetch_particles_false" && (sc == "3d_gimp_1mat" || sc == "2d_linear_room"))
-            continue;
-          if (lb == "prefetch_grid_false" && (sc == "3d_gimp_1mat" || sc == "2d_linear_room"))
-            continue;
+          const bool prefetch = lb == "prefetch_grid_false" || lb == "prefetch_particles_false";
+          if (sc == "2d_linear_1e6" && lb != "tile_16" && !prefetch) continue;
+          if (prefetch && (sc == "3d_gimp_1mat" || sc == "2d_linear_room")) continue;
           if (lb == "tile_16" && sc != "2d_linear_1e6") continue;
           if (lb == "tile_32" && (sc == "3d_gimp_1mat" || sc == "2d_linear_room")) continue;
         }
