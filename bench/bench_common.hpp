@@ -303,8 +303,10 @@ void make_block(ParticleSet<D, Real>& S, const BlockSpec& b) {
   for (int c = 0; c < NS; ++c) P.s[c] = S.add_real(n);
   for (int c = 0; c < D * D; ++c) P.L[c] = S.add_transient(n);
   for (int d = 0; d < D; ++d) P.x0[d] = S.add_real(n);
+  // uGIMP half-widths: one value for the whole block (uniform particles per
+  // cell), no column, as the Stepper's (kernels/particle_view.hpp half_width).
   if (b.gimp)
-    for (int d = 0; d < D; ++d) P.lp[d] = S.add_real(n);
+    for (int d = 0; d < D; ++d) P.lp_all[std::size_t(d)] = Real(0.5 / b.ppc);
   P.mat = S.add_byte(n);
   if (b.multifield) P.field = S.add_byte(n);
   S.key.allocate(n, S.slot++);
@@ -329,7 +331,6 @@ void make_block(ParticleSet<D, Real>& S, const BlockSpec& b) {
           P.x0[d][p] = Real(x[d]);
           // A smooth, non-trivial velocity field (values matter only for realism).
           P.v[d][p] = Real(0.1 * (1.0 + 0.3 * std::sin(0.05 * x[(d + 1) % D] + d)));
-          if (b.gimp) P.lp[d][p] = Real(0.5 * spacing);
         }
         P.m[p] = Real(1.2e-3 * vol);
         P.V[p] = Real(vol);

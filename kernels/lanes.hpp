@@ -89,14 +89,41 @@ inline V lanes_abs(const V& a) {
   using Bits = decltype(a < a);         // same-width integer lanes
   return (V)((Bits)a & ~(Bits)(-V{}));  // -V{}: lanes of -0.0, the sign bit alone
 }
-// max/min in the operand order of the x86 instructions, so they compile to
-// one vmaxp/vminp each.
+// max/min in the operand order of the x86 instructions (a > b ? a : b is
+// vmaxp a, b: b when they compare equal or either is a NaN). Written as
+// those instructions for 512-bit vectors: GCC 12 compiled the selects to a
+// compare into a mask and a blend (two instructions, the compare on the
+// one port that also shuffles) once the bounds were constants, as in the
+// uGIMP clamps (kernels/shape.hpp). By inline assembly: _mm512_max_pd
+// drew -Wmaybe-uninitialized (its undefined pass-through), and the masked
+// builtin with a zero pass-through crashed GCC 12's SLP vectoriser on
+// tests/test_p2g.cpp.
 template <class V>
 inline V lanes_max(const V& a, const V& b) {
+#if defined(__AVX512F__)
+  if constexpr (sizeof(V) == 64) {
+    V r;
+    if constexpr (std::is_same_v<LaneReal<V>, double>)
+      asm("vmaxpd %2, %1, %0" : "=v"(r) : "v"(a), "v"(b));
+    else
+      asm("vmaxps %2, %1, %0" : "=v"(r) : "v"(a), "v"(b));
+    return r;
+  }
+#endif
   return a > b ? a : b;
 }
 template <class V>
 inline V lanes_min(const V& a, const V& b) {
+#if defined(__AVX512F__)
+  if constexpr (sizeof(V) == 64) {
+    V r;
+    if constexpr (std::is_same_v<LaneReal<V>, double>)
+      asm("vminpd %2, %1, %0" : "=v"(r) : "v"(a), "v"(b));
+    else
+      asm("vminps %2, %1, %0" : "=v"(r) : "v"(a), "v"(b));
+    return r;
+  }
+#endif
   return a < b ? a : b;
 }
 template <class V>

@@ -155,8 +155,10 @@ struct PackedLinearBlock {
     if constexpr (kFrc) {
       // f = -V sigma . G (+ S fext); sigma: xx, yy, xy (window_block.hpp)
       const VW v0 = PL::spread(q.vs[0]), v1 = PL::spread(q.vs[1]), v2 = PL::spread(q.vs[2]);
-      af[0] -= v0 * Gx + v2 * Gy;
-      af[1] -= v2 * Gx + v1 * Gy;
+      af[0] -= v0 * Gx;  // term by term, as WindowBlock::accumulate
+      af[0] -= v2 * Gy;
+      af[1] -= v2 * Gx;
+      af[1] -= v1 * Gy;
       if constexpr (Traction)
         for (int d = 0; d < 2; ++d) af[d] += s * PL::spread(q.fe[d]);
     }

@@ -12,6 +12,14 @@ namespace mmpm {
 template <int D>
 inline constexpr int kStressComponents = D == 2 ? 4 : 6;
 
+// Two particles per cell and direction: a quarter cell.
+template <int D, class Real>
+constexpr std::array<Real, D> filled_half_widths() {
+  std::array<Real, D> l{};
+  l.fill(Real(0.25));
+  return l;
+}
+
 template <int D, class Real>
 struct ParticleView {
   std::size_t n = 0;
@@ -26,8 +34,11 @@ struct ParticleView {
   // Real: F's entries are ~1, and a float F lost strain increments below
   // 6e-8 (kernels/constitutive.hpp NeoHookeanPoint).
   std::array<Real*, D * D> H{};
-  std::array<Real*, D> x0{};      // initial position (displacement output / separation)
-  std::array<Real*, D> lp{};      // uGIMP half-width in cell units (gimp only)
+  std::array<Real*, D> x0{};  // initial position (displacement output / separation)
+  // uGIMP half-width in cell units (gimp only); null in direction d when
+  // every particle has the same one, lp_all[d] (half_width below).
+  std::array<Real*, D> lp{};
+  std::array<Real, D> lp_all = filled_half_widths<D, Real>();
   std::array<Real*, D> fext{};    // external (traction) force (only with traction loads)
   std::uint8_t* field = nullptr;  // material velocity field (only with > 1 field)
   std::uint8_t* mat = nullptr;    // material index
@@ -50,6 +61,13 @@ struct ParticleView {
 template <class T>
 T* offset_for_range(T* block, std::size_t first) {
   return reinterpret_cast<T*>(reinterpret_cast<std::uintptr_t>(block) - first * sizeof(T));
+}
+
+// Particle p's uGIMP half-width in direction d (cell units): its column's
+// value, or the one all particles share when the view has no column.
+template <int D, class Real>
+inline Real half_width(const ParticleView<D, Real>& P, int d, std::size_t p) {
+  return P.lp[std::size_t(d)] ? P.lp[std::size_t(d)][p] : P.lp_all[std::size_t(d)];
 }
 
 }  // namespace mmpm

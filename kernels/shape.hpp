@@ -81,6 +81,8 @@ struct GimpShape {
     for (int k = 0; k < 3; ++k) node(r - Real(k), l, w[k], dw[k]);
     return int(fb);
   }
+  // lanes() reads the half-widths l (uses_half_width below).
+  static constexpr bool half_width_lanes = true;
   // node() lane by lane.
   template <class V>
   static void lanes(const V& d, const V& l, V& w, V& dw) {
@@ -170,6 +172,12 @@ struct BSpline3Shape {
     w[3] = q3 * q3 * q3 / Real(6);
     dw[3] = Real(0.5) * q3 * q3;
   }
+};
+
+// Does Shape::lanes read the particles' half-widths (uGIMP)?
+template <class Shape>
+inline constexpr bool uses_half_width = requires {
+  requires Shape::half_width_lanes;
 };
 
 // Whether particles are binned by their nearest node k instead of their

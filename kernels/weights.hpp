@@ -27,7 +27,7 @@ struct Stencil {
     int b[D];
     for (int d = 0; d < D; ++d) {
       const Real xi = (P.x[d][p] - G.origin[d]) * inv_h[d];
-      const Real l = Shape::S == 3 && P.lp[d] ? P.lp[d][p] : Real(0);
+      const Real l = Shape::S == 3 ? half_width(P, d, p) : Real(0);
       b[d] = Shape::eval(xi, l, w1[d], d1[d]);
       if (b[d] < 0 || b[d] + S > G.nodes_per_dim[d]) return false;
     }

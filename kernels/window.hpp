@@ -352,15 +352,51 @@ class WindowBuilder {
     std::uint64_t window_base[kWeightBatch];
     int inside[kWeightBatch];
     locate_batch(P, first, count, r, window_base, inside);
-    const Real* lp[D];
-    for (int d = 0; d < D; ++d) lp[d] = Shape::S == 3 && P.lp[d] ? P.lp[d] + first : nullptr;
+    if constexpr (uses_half_width<Shape>) {
+      // Half-widths: a column's, or the one all particles share
+      // (P.lp_all). Without a column, one loop in which they are the same
+      // for every particle, so the compiler builds their lanes, and 1 /
+      // (2l), once per batch instead of per particle (2D uGIMP double: one
+      // vector division and three shuffles per particle less;
+      // docs/performance.md "One half-width for all particles"). One loop
+      // with a test per particle was not split by GCC, and kept them.
+      const Real* lp[D];
+      bool shared = true;
+      for (int d = 0; d < D; ++d) {
+        lp[d] = P.lp[d] ? P.lp[d] + first : nullptr;
+        shared = shared && !lp[d];
+      }
+      if (shared) {
+        const std::array<Real, D> all = P.lp_all;
+        shape_each(r, window_base, inside, count, w, ok,
+                   [all](int d, std::size_t) { return all[std::size_t(d)]; });
+      } else {
+        shape_each(r, window_base, inside, count, w, ok, [&](int d, std::size_t i) {
+          return lp[d] ? lp[d][i] : P.lp_all[std::size_t(d)];
+        });
+      }
+    } else {
+      // The other shapes ignore l. (Reading P.lp_all here too, the 3D
+      // cubic B-spline gathers of tests/test_p2g.cpp crashed GCC 12's SLP
+      // vectoriser.)
+      shape_each(r, window_base, inside, count, w, ok, [](int, std::size_t) { return Real(0.25); });
+    }
+  }
+
+  // The shape function of each window of a batch whose distances and bases
+  // locate_batch found; half_width(d, i): particle first + i's in direction d.
+  template <class HalfWidth>
+  [[gnu::always_inline]] void shape_each(const Real (&r)[D][kWeightBatch],
+                                         const std::uint64_t (&window_base)[kWeightBatch],
+                                         const int (&inside)[kWeightBatch], std::size_t count,
+                                         Win* w, bool* ok, HalfWidth half_width_of) const {
     for (std::size_t i = 0; i < count; ++i) {
       ok[i] = inside[i] != 0;
       if (!ok[i]) continue;
       Real ri[DP], li[DP];
       for (int d = 0; d < D; ++d) {
         ri[d] = r[d][i];
-        li[d] = lp[d] ? lp[d][i] : Real(0.25);
+        li[d] = half_width_of(d, i);
       }
       shape(ri, li, w[i]);
       w[i].base = window_base[i];
@@ -430,7 +466,7 @@ class WindowBuilder {
       // Window base: key cell - window_lo, moved inward at the grid's edges.
       const int wb = std::clamp(int(xi) - Shape::window_lo, 0, top[d]);
       r[d] = xi - Real(wb);
-      l[d] = Shape::S == 3 && P.lp[d] ? P.lp[d][p] : Real(0.25);
+      l[d] = uses_half_width<Shape> ? half_width(P, d, p) : Real(0.25);
       base += std::size_t(wb) * stride;
       stride *= std::size_t(n[d]);
     }

@@ -240,15 +240,29 @@ struct WindowBlock {
       if constexpr (kMom)
         for (int d = 0; d < D; ++d) ap[d][u] += s * q.mv[d];
       if constexpr (kFrc) {
-        // f = -V sigma . G (+ S fext); 2D sigma: xx, yy, xy, zz; 3D Voigt: xx, yy, zz, yz, xz, xy
+        // f = -V sigma . G (+ S fext); 2D sigma: xx, yy, xy, zz; 3D Voigt: xx, yy, zz, yz, xz, xy.
+        // Each term subtracted on its own: one negated multiply-add per
+        // term, where subtracting the sum cost a multiply, a multiply-add
+        // per further term and a subtraction (the sum's order is fixed
+        // without -ffast-math). The 2D uGIMP P2G is bound by its vector
+        // instructions (docs/performance.md "The force's terms subtracted
+        // one by one").
         if constexpr (D == 2) {
-          af[0][u] -= q.vs[0] * Gx + q.vs[2] * Gy;
-          af[1][u] -= q.vs[2] * Gx + q.vs[1] * Gy;
+          af[0][u] -= q.vs[0] * Gx;
+          af[0][u] -= q.vs[2] * Gy;
+          af[1][u] -= q.vs[2] * Gx;
+          af[1][u] -= q.vs[1] * Gy;
         } else {
           const V Gz = X * Units::template GZ<wu>(win);
-          af[0][u] -= q.vs[0] * Gx + q.vs[5] * Gy + q.vs[4] * Gz;
-          af[1][u] -= q.vs[5] * Gx + q.vs[1] * Gy + q.vs[3] * Gz;
-          af[2][u] -= q.vs[4] * Gx + q.vs[3] * Gy + q.vs[2] * Gz;
+          af[0][u] -= q.vs[0] * Gx;
+          af[0][u] -= q.vs[5] * Gy;
+          af[0][u] -= q.vs[4] * Gz;
+          af[1][u] -= q.vs[5] * Gx;
+          af[1][u] -= q.vs[1] * Gy;
+          af[1][u] -= q.vs[3] * Gz;
+          af[2][u] -= q.vs[4] * Gx;
+          af[2][u] -= q.vs[3] * Gy;
+          af[2][u] -= q.vs[2] * Gz;
         }
         if constexpr (Traction)
           for (int d = 0; d < D; ++d) af[d][u] += s * q.fe[d];

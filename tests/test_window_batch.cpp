@@ -125,4 +125,86 @@ TYPED_TEST(WindowBatch, SameWindowsAndVerdictsAsOneByOne) {
   }
 }
 
+// A view without half-width columns (every particle has P.lp_all, as the
+// Stepper builds it when all bodies share one particle spacing) gives
+// bitwise the windows of columns that hold those values everywhere: the
+// batch's shared lanes are built once, the column's per particle. Also with
+// a column in one direction only (the Stepper's choice when the spacings
+// differ in that direction alone).
+TYPED_TEST(WindowBatch, SharedHalfWidthGivesTheColumnsWindows) {
+  constexpr int D = TypeParam::D;
+  using Shape = typename TypeParam::Shape;
+  using Real = typename TypeParam::Real;
+  using Builder = WindowBuilder<D, Shape, Real>;
+  using Win = Window<D, Shape, Real>;
+
+  GridView<D, Real> G;
+  const int cells[3] = {12, 9, 7};
+  const double h[3] = {0.5, 0.25, 0.75}, origin[3] = {-1.0, 2.0, 0.5};
+  const Real shared_l[3] = {Real(0.3), Real(0.2), Real(0.35)};
+  G.nodes = 1;
+  for (int d = 0; d < D; ++d) {
+    G.nodes_per_dim[std::size_t(d)] = cells[d] + 1;
+    G.h[std::size_t(d)] = Real(h[d]);
+    G.origin[std::size_t(d)] = Real(origin[d]);
+    G.nodes *= std::size_t(cells[d] + 1);
+  }
+  const std::size_t n = 300;
+  std::vector<Real> x[D], lp[D];
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  ParticleView<D, Real> columns, shared, mixed;
+  for (auto* P : {&columns, &shared, &mixed}) P->n = n;
+  for (int d = 0; d < D; ++d) {
+    x[d].resize(n);
+    lp[d].assign(n, shared_l[d]);
+    for (std::size_t p = 0; p < n; ++p)
+      x[d][p] = Real(origin[d] + (0.6 + (cells[d] - 1.2) * u(rng)) * h[d]);
+    for (auto* P : {&columns, &shared, &mixed}) P->x[std::size_t(d)] = x[d].data();
+    columns.lp[std::size_t(d)] = lp[d].data();
+    shared.lp_all[std::size_t(d)] = shared_l[d];
+    mixed.lp_all[std::size_t(d)] = shared_l[d];
+  }
+  mixed.lp[0] = lp[0].data();
+
+  const Builder builder(G);
+  std::size_t compared = 0;
+  for (std::size_t first = 0; first < n; first += kWeightBatch) {
+    const std::size_t count = std::min(kWeightBatch, n - first);
+    Win wc[kWeightBatch], ws[kWeightBatch], wm[kWeightBatch];
+    bool okc[kWeightBatch], oks[kWeightBatch], okm[kWeightBatch];
+    builder.build_batch(columns, first, count, wc, okc);
+    builder.build_batch(shared, first, count, ws, oks);
+    builder.build_batch(mixed, first, count, wm, okm);
+    for (std::size_t i = 0; i < count; ++i) {
+      const std::size_t p = first + i;
+      ASSERT_EQ(okc[i], oks[i]) << "particle " << p;
+      ASSERT_EQ(okc[i], okm[i]) << "particle " << p;
+      if (!okc[i]) continue;
+      Win one;
+      ASSERT_TRUE(builder.build(shared, p, one));
+      for (const Win* w : {&ws[i], &wm[i], &one}) {
+        ASSERT_EQ(w->base, wc[i].base) << "particle " << p;
+        ASSERT_EQ(std::memcmp(&w->wa, &wc[i].wa, sizeof(w->wa)), 0) << "particle " << p;
+        ASSERT_EQ(std::memcmp(&w->dwa, &wc[i].dwa, sizeof(w->dwa)), 0) << "particle " << p;
+      }
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, n / 2);
+  // The half-width matters to uGIMP: another shared value changes its windows.
+  if constexpr (std::is_same_v<Shape, GimpShape>) {
+    ParticleView<D, Real> other = shared;
+    other.lp_all[0] = Real(0.1);
+    Win a[kWeightBatch], b[kWeightBatch];
+    bool oka[kWeightBatch], okb[kWeightBatch];
+    builder.build_batch(shared, 0, kWeightBatch, a, oka);
+    builder.build_batch(other, 0, kWeightBatch, b, okb);
+    bool differ = false;
+    for (std::size_t i = 0; i < kWeightBatch; ++i)
+      differ = differ || (oka[i] && std::memcmp(&a[i].wa, &b[i].wa, sizeof(a[i].wa)) != 0);
+    EXPECT_TRUE(differ);
+  }
+}
+
 }  // namespace

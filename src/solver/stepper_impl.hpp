@@ -123,8 +123,21 @@ void Stepper<D, Shape, Real>::setup_particles(const ParticleSeeds& seeds) {
     for (int c = 0; c < D * D; ++c) P_.H[c] = pcols_.add_real("H" + std::to_string(c), n);
   if (need_x0)
     for (int d = 0; d < D; ++d) P_.x0[d] = pcols_.add_real(std::string("x0") + axis[d], n);
+  // uGIMP half-widths: a column only in a direction where the particles'
+  // differ (bodies seeded with different particles per cell); else the
+  // one value in the view (kernels/particle_view.hpp half_width), and the
+  // transfers build its lanes once per batch instead of reading a column
+  // (docs/performance.md "One half-width for all particles").
   if (scene_.grid.shape == ShapeKind::gimp)
-    for (int d = 0; d < D; ++d) P_.lp[d] = pcols_.add_real(std::string("lp") + axis[d], n);
+    for (int d = 0; d < D; ++d) {
+      const Real first = n > 0 ? Real(seeds.half_width[0][d]) : P_.lp_all[std::size_t(d)];
+      const bool shared = std::all_of(seeds.half_width.begin(), seeds.half_width.end(),
+                                      [&](const Vec3& l) { return Real(l[d]) == first; });
+      if (shared)
+        P_.lp_all[std::size_t(d)] = first;
+      else
+        P_.lp[d] = pcols_.add_real(std::string("lp") + axis[d], n);
+    }
   if (has_traction_)
     for (int d = 0; d < D; ++d) P_.fext[d] = pcols_.add_real(std::string("fext") + axis[d], n);
   P_.mat = pcols_.add_byte("mat", n);

@@ -146,7 +146,10 @@ struct Row {
 std::vector<Row> rows_of(const Case& c, bool musl, double nodes_per_particle) {
   const int D = c.dim, NS = D == 2 ? 4 : 6, nodes = D == 2 ? c.S * c.S : c.S * c.S * c.S;
   const double R = std::strcmp(c.precision, "double") == 0 ? 8.0 : 4.0;
-  const int lp = std::strcmp(c.shape, "gimp") == 0 ? D : 0;  // uGIMP half-widths
+  // uGIMP half-widths: no column here (one body, one particle spacing: the
+  // Stepper keeps the one value in the particle view; before 2026-12-01
+  // every uGIMP step read D columns of them, counted here then).
+  const int lp = 0;
   const double grid = nodes_per_particle * R * 2.0;  // one grid array read + written per step
   // The force needs the in-plane stresses only: 3 of the 4 in 2D (not zz).
   const int NS_force = D == 2 ? 3 : 6;
