@@ -40,16 +40,12 @@ using Configs = ::testing::Types<
     Cfg<3, BSpline2Shape, double>, Cfg<3, BSpline3Shape, double>>;
 TYPED_TEST_SUITE(WindowBatch, Configs, CfgNames);
 
-TYPED_TEST(WindowBatch, SameWindowsAndVerdictsAsOneByOne) {
-  constexpr int D = TypeParam::D;
-  using Shape = typename TypeParam::Shape;
-  using Real = typename TypeParam::Real;
-  using Builder = WindowBuilder<D, Shape, Real>;
-  using Win = Window<D, Shape, Real>;
-
+// The grid of these tests: cells, spacing and origin differ per direction.
+constexpr int cells[3] = {12, 9, 7};
+constexpr double h[3] = {0.5, 0.25, 0.75}, origin[3] = {-1.0, 2.0, 0.5};
+template <int D, class Real>
+GridView<D, Real> test_grid() {
   GridView<D, Real> G;
-  const int cells[3] = {12, 9, 7};
-  const double h[3] = {0.5, 0.25, 0.75}, origin[3] = {-1.0, 2.0, 0.5};
   G.nodes = 1;
   for (int d = 0; d < D; ++d) {
     G.nodes_per_dim[std::size_t(d)] = cells[d] + 1;
@@ -57,6 +53,17 @@ TYPED_TEST(WindowBatch, SameWindowsAndVerdictsAsOneByOne) {
     G.origin[std::size_t(d)] = Real(origin[d]);
     G.nodes *= std::size_t(cells[d] + 1);
   }
+  return G;
+}
+
+TYPED_TEST(WindowBatch, SameWindowsAndVerdictsAsOneByOne) {
+  constexpr int D = TypeParam::D;
+  using Shape = typename TypeParam::Shape;
+  using Real = typename TypeParam::Real;
+  using Builder = WindowBuilder<D, Shape, Real>;
+  using Win = Window<D, Shape, Real>;
+
+  const GridView<D, Real> G = test_grid<D, Real>();
 
   // Positions: random, then the special ones in direction 0 (mid-grid in the
   // others).
@@ -138,17 +145,8 @@ TYPED_TEST(WindowBatch, SharedHalfWidthGivesTheColumnsWindows) {
   using Builder = WindowBuilder<D, Shape, Real>;
   using Win = Window<D, Shape, Real>;
 
-  GridView<D, Real> G;
-  const int cells[3] = {12, 9, 7};
-  const double h[3] = {0.5, 0.25, 0.75}, origin[3] = {-1.0, 2.0, 0.5};
+  const GridView<D, Real> G = test_grid<D, Real>();
   const Real shared_l[3] = {Real(0.3), Real(0.2), Real(0.35)};
-  G.nodes = 1;
-  for (int d = 0; d < D; ++d) {
-    G.nodes_per_dim[std::size_t(d)] = cells[d] + 1;
-    G.h[std::size_t(d)] = Real(h[d]);
-    G.origin[std::size_t(d)] = Real(origin[d]);
-    G.nodes *= std::size_t(cells[d] + 1);
-  }
   const std::size_t n = 300;
   std::vector<Real> x[D], lp[D];
   std::mt19937 rng(5);
