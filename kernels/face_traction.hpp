@@ -76,7 +76,7 @@ struct FaceStencil {
     for (int d = 0; d < D; ++d) {
       // The particle's stencil, as the transfers find it (kernels/weights.hpp).
       const Real xi = (P.x[d][p] - G.origin[d]) * (Real(1) / G.h[d]);
-      const Real l = Shape::S == 3 ? half_width(P, d, p) : Real(0);
+      const Real l = uses_half_width<Shape> ? half_width(P, d, p) : Real(0);
       Real w1[S], d1[S];
       b[d] = Shape::eval(xi, l, w1, d1);
       if (b[d] < 0 || b[d] + S > G.nodes_per_dim[d]) return false;

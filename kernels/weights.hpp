@@ -7,6 +7,7 @@
 
 #include "kernels/grid_view.hpp"
 #include "kernels/particle_view.hpp"
+#include "kernels/shape.hpp"
 
 namespace mmpm {
 
@@ -27,7 +28,7 @@ struct Stencil {
     int b[D];
     for (int d = 0; d < D; ++d) {
       const Real xi = (P.x[d][p] - G.origin[d]) * inv_h[d];
-      const Real l = Shape::S == 3 ? half_width(P, d, p) : Real(0);
+      const Real l = uses_half_width<Shape> ? half_width(P, d, p) : Real(0);
       b[d] = Shape::eval(xi, l, w1[d], d1[d]);
       if (b[d] < 0 || b[d] + S > G.nodes_per_dim[d]) return false;
     }

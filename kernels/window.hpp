@@ -360,20 +360,15 @@ class WindowBuilder {
       // vector division and three shuffles per particle less;
       // docs/performance.md "One half-width for all particles"). One loop
       // with a test per particle was not split by GCC, and kept them.
-      const Real* lp[D];
       bool shared = true;
-      for (int d = 0; d < D; ++d) {
-        lp[d] = P.lp[d] ? P.lp[d] + first : nullptr;
-        shared = shared && !lp[d];
-      }
+      for (int d = 0; d < D; ++d) shared = shared && !P.lp[std::size_t(d)];
       if (shared) {
         const std::array<Real, D> all = P.lp_all;
         shape_each(r, window_base, inside, count, w, ok,
                    [all](int d, std::size_t) { return all[std::size_t(d)]; });
       } else {
-        shape_each(r, window_base, inside, count, w, ok, [&](int d, std::size_t i) {
-          return lp[d] ? lp[d][i] : P.lp_all[std::size_t(d)];
-        });
+        shape_each(r, window_base, inside, count, w, ok,
+                   [&P, first](int d, std::size_t i) { return half_width(P, d, first + i); });
       }
     } else {
       // The other shapes ignore l. (Reading P.lp_all here too, the 3D

@@ -146,27 +146,25 @@ struct Row {
 std::vector<Row> rows_of(const Case& c, bool musl, double nodes_per_particle) {
   const int D = c.dim, NS = D == 2 ? 4 : 6, nodes = D == 2 ? c.S * c.S : c.S * c.S * c.S;
   const double R = std::strcmp(c.precision, "double") == 0 ? 8.0 : 4.0;
-  // uGIMP half-widths: no column here (one body, one particle spacing: the
-  // Stepper keeps the one value in the particle view; before 2026-12-01
+  // uGIMP half-widths move no bytes: one body, one particle spacing, so the
+  // Stepper keeps the one value in the particle view (before 2026-12-01
   // every uGIMP step read D columns of them, counted here then).
-  const int lp = 0;
   const double grid = nodes_per_particle * R * 2.0;  // one grid array read + written per step
   // The force needs the in-plane stresses only: 3 of the 4 in 2D (not zz).
   const int NS_force = D == 2 ? 3 : 6;
-  const double p2g_bytes = R * (2 * D + 2 + NS_force + lp) + grid * (1 + 2 * D);
+  const double p2g_bytes = R * (2 * D + 2 + NS_force) + grid * (1 + 2 * D);
   // L goes through memory in USL (G2P writes it, the constitutive pass
   // reads it); MUSL's fused tail keeps it in a per-thread block of one tile
   // (solver/stepper_impl.hpp fused_step_tail), so it moves no bytes there.
   const int L = musl ? 0 : D * D;
-  // USL's G2P reads x, (lp), v and writes v, x, L; MUSL's two passes (the
+  // USL's G2P reads x, v and writes v, x, L; MUSL's two passes (the
   // first scatters m v, the gradient pass moves x) read m too, once.
-  const double g2p_bytes =
-      R * (2 * D + lp + (musl ? 1 : 0)) + 4 + R * (2 * D + L) + grid / 2 * (2 * D);
+  const double g2p_bytes = R * (2 * D + (musl ? 1 : 0)) + 4 + R * (2 * D + L) + grid / 2 * (2 * D);
   const double con_bytes = R * (L + NS + 1) + R * (NS + 1);
-  // The step: every persistent column once; reads x, v, m, V, sigma, (lp),
-  // key; writes x, v, V, sigma (and L in USL); the grid's m, p, f, vel, dvel.
+  // The step: every persistent column once; reads x, v, m, V, sigma, key;
+  // writes x, v, V, sigma (and L in USL); the grid's m, p, f, vel, dvel.
   const double step_bytes =
-      R * (2 * D + 2 + NS + lp) + 4 + R * (2 * D + 1 + NS + L) + grid * (1 + 4 * D);
+      R * (2 * D + 2 + NS) + 4 + R * (2 * D + 1 + NS + L) + grid * (1 + 4 * D);
   const double stencil = D * (c.S == 2 ? 4.0 : 14.0) + nodes * (D + 1.0);
   const double p2g_flops = stencil + 2 * D + NS + nodes * (2.0 + 2 * D + 4.0 * D);
   const double one_g2p = stencil + nodes * (4.0 * D + 2.0 * D * D) + 6 * D;
