@@ -304,6 +304,14 @@ class WindowBuilder {
                                     : 1;
   static constexpr int PL = W * DP / kParts;  // lanes per part
   using Part = Lanes<Real, PL>;
+  // Two particles' shape functions in one register where one particle's
+  // lanes fill half of it (2D float uGIMP and B-splines: 8 of 16 lanes; 3D
+  // linear float): the shape function's ~16 vector operations (uGIMP)
+  // then serve two windows (docs/performance.md "Two windows' shape
+  // functions per register"). Lane by lane the same operations, so the
+  // same bits.
+  static constexpr bool kPairShape = kParts == 1 && 2 * sizeof(VA) <= kRegisterVectorBytes;
+  using Pair = std::conditional_t<kPairShape, Lanes<Real, 2 * PL>, Part>;
 
   // Lowest xi the stencil allows, and the margin it needs above: linear
   // [0, n - 1), uGIMP and quadratic [1/2, n - 3/2) (stencil base
@@ -335,6 +343,15 @@ class WindowBuilder {
       inv_h_lanes[h] = scale;
       offsets_lanes[h] = offset;
       direction_lanes[h] = direction;
+    }
+    if constexpr (kPairShape) {
+      Pair scale{}, offset{};
+      for (int j = 0; j < 2 * PL; ++j) {
+        scale[j] = inv_h_lanes[0][j % PL];
+        offset[j] = offsets_lanes[0][j % PL];
+      }
+      inv_h_pair = scale;
+      offsets_pair = offset;
     }
   }
 
@@ -385,7 +402,25 @@ class WindowBuilder {
                                          const std::uint64_t (&window_base)[kWeightBatch],
                                          const int (&inside)[kWeightBatch], std::size_t count,
                                          Win* w, bool* ok, HalfWidth half_width_of) const {
-    for (std::size_t i = 0; i < count; ++i) {
+    std::size_t i = 0;
+    if constexpr (kPairShape) {
+      // Windows of particles off the grid are built too (their distances
+      // are finite) and never read.
+      for (; i + 1 < count; i += 2) {
+        ok[i] = inside[i] != 0;
+        ok[i + 1] = inside[i + 1] != 0;
+        Real ri[2][DP], li[2][DP];
+        for (int h = 0; h < 2; ++h)
+          for (int d = 0; d < D; ++d) {
+            ri[h][d] = r[d][i + std::size_t(h)];
+            li[h][d] = half_width_of(d, i + std::size_t(h));
+          }
+        shape_pair(ri, li, w[i], w[i + 1]);
+        w[i].base = window_base[i];
+        w[i + 1].base = window_base[i + 1];
+      }
+    }
+    for (; i < count; ++i) {
       ok[i] = inside[i] != 0;
       if (!ok[i]) continue;
       Real ri[DP], li[DP];
@@ -500,11 +535,42 @@ class WindowBuilder {
     }
   }
 
+  // shape() of two windows at once (kPairShape): lanes 0 .. PL - 1 are
+  // w0's, PL .. 2 PL - 1 w1's.
+  [[gnu::always_inline]] void shape_pair(Real (&r)[2][DP], Real (&l)[2][DP], Win& w0,
+                                         Win& w1) const {
+    Pair rv{}, lv{};
+    for (int h = 0; h < 2; ++h) {
+      if constexpr (DP > D) r[h][DP - 1] = Real(0.5), l[h][DP - 1] = Real(0.25);
+      for (int d = 0; d < DP; ++d) rv[h * DP + d] = r[h][d], lv[h * DP + d] = l[h][d];
+    }
+    constexpr auto seq = std::make_index_sequence<2 * PL>{};
+    Pair pw, pdw;
+    Shape::lanes(spread_pair(rv, seq) + offsets_pair, spread_pair(lv, seq), pw, pdw);
+    pdw *= inv_h_pair;
+    constexpr auto lo = std::make_index_sequence<PL>{};
+    w0.wa = half_of<0>(pw, lo);
+    w1.wa = half_of<PL>(pw, lo);
+    w0.dwa = half_of<0>(pdw, lo);
+    w1.dwa = half_of<PL>(pdw, lo);
+  }
+
  private:
   // Lane d * W + k = lane d of t.
   template <std::size_t... I>
   static VA spread(const VA& t, std::index_sequence<I...>) {
     return __builtin_shufflevector(t, t, int(I / W)...);
+  }
+  // Lane k = lane d of particle h's DP lanes in t (k: particle h = k / PL,
+  // direction d = k % PL / W).
+  template <std::size_t... I>
+  static Pair spread_pair(const Pair& t, std::index_sequence<I...>) {
+    return __builtin_shufflevector(t, t, int(I / PL * DP + I % PL / W)...);
+  }
+  // Lanes first .. first + PL - 1 of v.
+  template <int first, std::size_t... I>
+  static VA half_of(const Pair& v, std::index_sequence<I...>) {
+    return __builtin_shufflevector(v, v, int(first + I)...);
   }
   // Lane k of part h = v[direction of lane h * PL + k].
   [[gnu::always_inline]] Part per_direction(const Real (&v)[DP], int h) const {
@@ -515,6 +581,7 @@ class WindowBuilder {
   Real inv_h[D]{}, origin[D]{};  // origin: the key origin (kernels/binning.hpp)
   int n[D]{}, top[D]{};          // top: the highest window base
   Part inv_h_lanes[kParts]{}, offsets_lanes[kParts]{}, direction_lanes[kParts]{};
+  Pair inv_h_pair{}, offsets_pair{};  // inv_h_lanes[0], offsets_lanes[0] twice (kPairShape)
 };
 
 }  // namespace mmpm
