@@ -3,8 +3,8 @@
 //
 // 1. The machine: STREAM-like triad bandwidth (a = b + s c, 3 arrays of 2^24
 //    doubles, bytes counted as 4 per element moved because the store
-//    allocates its line) and the peak FMA rate (16 independent vector FMA
-//    chains per thread, 2 flops per lane).
+//    allocates its line) and the peak FMA rate (12 independent FMA chains
+//    of one register each per thread, 2 flops per lane).
 // 2. Whole-solver steps of a block filling the grid (one material), for
 //    each case in the default scheme (MUSL, its step tail fused: P2G runs
 //    inside the tail on columns the tail's G2P has just read) and in USL
@@ -40,6 +40,7 @@
 #include <string>
 #include <vector>
 
+#include "kernels/lanes.hpp"
 #include "kernels/team.hpp"
 #include "scene/parse.hpp"
 #include "solver/simulation.hpp"
@@ -87,8 +88,16 @@ struct Triad {
   }
 };
 
+// One register of doubles per chain, and fewer chains than registers: 16
+// chains of 8 doubles are 32 registers on an AVX2 target (16 ymm), whose
+// spills halved the measured peak (19.6 against 46.6 GFLOP/s on a 2445 MHz
+// Zen 3 core; docs/performance.md "The peak FMA rate on AVX2 targets").
+// 12 chains cover the FMA latency times the FMA ports (4 x 2) with room.
+inline constexpr int kPeakLanes = int(mmpm::kRegisterVectorBytes / sizeof(double));
+inline constexpr int kPeakChains = 12;
+
 double peak_gflops(int threads, long iters = 20000000) {
-  constexpr int kChains = 16, kLanes = 8;
+  constexpr int kChains = kPeakChains, kLanes = kPeakLanes;
   omp_set_num_threads(threads);
   std::atomic<long> total_flops{0};
   const auto t0 = Clock::now();
@@ -259,9 +268,9 @@ int main(int argc, char** argv) {
     return m;
   };
   std::printf(
-      "machine (%d thread%s): triad (a = b + s c, 3 x 128 MiB) and peak FMA (double, 8 lanes) "
-      "measured around every block of %d steps, %d blocks per case and scheme\n\n",
-      threads, threads > 1 ? "s" : "", steps, blocks);
+      "machine (%d thread%s): triad (a = b + s c, 3 x 128 MiB) and peak FMA (double, %d chains "
+      "of %d lanes) measured around every block of %d steps, %d blocks per case and scheme\n\n",
+      threads, threads > 1 ? "s" : "", kPeakChains, kPeakLanes, steps, blocks);
   std::printf("%-17s %-5s %-12s %8s %6s %6s %7s %7s %8s %8s %8s %12s %12s\n", "case", "sch.",
               "stage", "ns/part", "B/part", "fl/p", "GB/s", "GFLOP/s", "bound ns", "x bound",
               "x b. min", "triad GB/s", "peak GFLOP/s");
