@@ -62,6 +62,14 @@ TEST(Cli, InfoMentionsSimdAndOpenMP) {
   ASSERT_EQ(r.exit_code, 0) << r.describe();
   EXPECT_TRUE(contains(lower(r.out), "simd")) << r.out;
   EXPECT_TRUE(contains(lower(r.out), "openmp")) << r.out;
+  // Which 2D linear transfers this build runs (packed only with AVX-512).
+#ifdef __AVX512F__
+  EXPECT_TRUE(
+      contains(r.out, "2d linear kernels: packed (2 particles per vector in double, 4 in float)"))
+      << r.out;
+#else
+  EXPECT_TRUE(contains(r.out, "2d linear kernels: one particle per vector")) << r.out;
+#endif
 }
 
 TEST(Cli, CheckShippedScene) {

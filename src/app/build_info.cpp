@@ -8,6 +8,8 @@
 #include <sstream>
 #include <thread>
 
+#include "kernels/packed_linear.hpp"
+
 namespace mmpm {
 
 std::string build_description() {
@@ -23,6 +25,17 @@ std::string build_description() {
 #else
   os << "simd: none\n";
 #endif
+  // Which 2D linear transfers run: the packed ones (several particles per
+  // register) need AVX-512; an AVX2 build's 2D linear step is 1.34x slower
+  // on the same core (docs/performance.md "The AVX2 build on the AVX-512
+  // host"), so a user comparing machines should see which one runs.
+  constexpr int packed_double = packed_particles<2, LinearShape, double>();
+  constexpr int packed_float = packed_particles<2, LinearShape, float>();
+  if constexpr (packed_double > 1)
+    os << "2d linear kernels: packed (" << packed_double << " particles per vector in double, "
+       << packed_float << " in float)\n";
+  else
+    os << "2d linear kernels: one particle per vector (the packed kernels need AVX-512)\n";
   os << "openmp: " << _OPENMP << ", max threads " << omp_get_max_threads() << "\n";
   os << "hardware threads: " << std::thread::hardware_concurrency() << "\n";
   os << "eigen: " << EIGEN_WORLD_VERSION << "." << EIGEN_MAJOR_VERSION << "." << EIGEN_MINOR_VERSION
