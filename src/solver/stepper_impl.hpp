@@ -3,6 +3,19 @@
 
 namespace mmpm {
 
+// The stress components a particle has, as Voigt indices (xx yy zz yz xz
+// xy) and as its stress columns: 3D all six in Voigt order; 2D xx, yy, zz,
+// xy, whose columns are stored xx, yy, xy, zz (yz and xz are 0). The
+// strain energy and the strain output read the stress through this map.
+template <int D>
+struct StressVoigt {
+  static constexpr int count = D == 2 ? 4 : 6;
+  static constexpr std::array<int, 6> voigt =
+      D == 2 ? std::array<int, 6>{0, 1, 2, 5, 0, 0} : std::array<int, 6>{0, 1, 2, 3, 4, 5};
+  static constexpr std::array<int, 6> column =
+      D == 2 ? std::array<int, 6>{0, 1, 3, 2, 0, 0} : std::array<int, 6>{0, 1, 2, 3, 4, 5};
+};
+
 template <int D, class Shape, class Real>
 Stepper<D, Shape, Real>::Stepper(const Scene& scene) : scene_(scene), plan_(plan_fields(scene)) {
   for (const auto& m : scene.materials)
@@ -1305,17 +1318,13 @@ Energies Stepper<D, Shape, Real>::energies() const {
   // added in the same order, so the sum keeps its bits. Why: with a series
   // row every step the old loop cost 11 ns/particle per row, half of a 2D
   // linear step (docs/performance.md "The energies of a series row").
-  constexpr int NV = D == 2 ? 4 : 6;
-  constexpr std::array<int, 6> kVoigt =
-      D == 2 ? std::array<int, 6>{0, 1, 2, 5, 0, 0} : std::array<int, 6>{0, 1, 2, 3, 4, 5};
-  // The particle's stress column of Voigt component kVoigt[i] (2D: s holds
-  // xx, yy, xy, zz).
-  constexpr std::array<int, 6> kColumn =
-      D == 2 ? std::array<int, 6>{0, 1, 3, 2, 0, 0} : std::array<int, 6>{0, 1, 2, 3, 4, 5};
+  using Map = StressVoigt<D>;
+  constexpr int NV = Map::count;
+  enum class Kind : unsigned char { rigid, small_strain, finite_strain };
   struct EnergyMaterial {
-    double c[NV][NV];
+    double c[NV][NV];  // compliance over the components of Map
     double mu, lambda, density;
-    unsigned char kind;  // 0: rigid (no energy), 1: small strain, 2: finite strain
+    Kind kind;
   };
   std::vector<EnergyMaterial> table(materials_.size());
   for (std::size_t k = 0; k < materials_.size(); ++k) {
@@ -1323,9 +1332,11 @@ Energies Stepper<D, Shape, Real>::energies() const {
     EnergyMaterial& t = table[k];
     for (int i = 0; i < NV; ++i)
       for (int j = 0; j < NV; ++j)
-        t.c[i][j] = mat.compliance[kVoigt[std::size_t(i)]][kVoigt[std::size_t(j)]];
+        t.c[i][j] = mat.compliance[Map::voigt[std::size_t(i)]][Map::voigt[std::size_t(j)]];
     t.mu = mat.k.mu, t.lambda = mat.k.lambda, t.density = mat.density;
-    t.kind = mat.rigid() ? 0 : mat.finite_strain() ? 2 : 1;
+    t.kind = mat.rigid()           ? Kind::rigid
+             : mat.finite_strain() ? Kind::finite_strain
+                                   : Kind::small_strain;
   }
   const EnergyMaterial* const mats = table.data();
   auto parts =
@@ -1335,11 +1346,11 @@ Energies Stepper<D, Shape, Real>::energies() const {
           // system's energy: its work on the bodies is external work
           // (add_rigid_work), and its nominal mass carries no kinetic energy.
           const EnergyMaterial& mat = mats[P_.mat[p]];
-          if (mat.kind == 0) continue;
+          if (mat.kind == Kind::rigid) continue;
           double v2 = 0;
           for (int d = 0; d < D; ++d) v2 += double(P_.v[d][p]) * double(P_.v[d][p]);
           acc[0] += 0.5 * double(P_.m[p]) * v2;
-          if (mat.kind == 2) {
+          if (mat.kind == Kind::finite_strain) {
             double F[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
             for (int i = 0; i < D; ++i)
               for (int j = 0; j < D; ++j) F[i * 3 + j] += double(P_.H[i * D + j][p]);
@@ -1352,7 +1363,7 @@ Energies Stepper<D, Shape, Real>::energies() const {
             acc[1] += V0 * (0.5 * mat.mu * (I1 - 3 - 2 * lnJ) + 0.5 * mat.lambda * lnJ * lnJ);
           } else {
             double s[NV];
-            for (int i = 0; i < NV; ++i) s[i] = double(P_.s[kColumn[std::size_t(i)]][p]);
+            for (int i = 0; i < NV; ++i) s[i] = double(P_.s[Map::column[std::size_t(i)]][p]);
             double u = 0;
             for (int i = 0; i < NV; ++i)
               for (int j = 0; j < NV; ++j) u += s[i] * mat.c[i][j] * s[j];
@@ -1438,12 +1449,9 @@ io::ParticleField Stepper<D, Shape, Real>::particle_field(const std::string& nam
         e[3] = 0.5 * C(1, 2), e[4] = 0.5 * C(0, 2), e[5] = 0.5 * C(0, 1);
       } else if (!mat.rigid()) {
         double sv[6] = {0, 0, 0, 0, 0, 0};
-        if constexpr (D == 2) {
-          sv[0] = double(P_.s[0][p]), sv[1] = double(P_.s[1][p]), sv[2] = double(P_.s[3][p]),
-          sv[5] = double(P_.s[2][p]);
-        } else {
-          for (int c = 0; c < 6; ++c) sv[c] = double(P_.s[c][p]);
-        }
+        using Map = StressVoigt<D>;
+        for (int i = 0; i < Map::count; ++i)
+          sv[Map::voigt[std::size_t(i)]] = double(P_.s[Map::column[std::size_t(i)]][p]);
         for (int i = 0; i < 6; ++i) {
           for (int j = 0; j < 6; ++j) e[i] += mat.compliance[i][j] * sv[j];
           if (i >= 3) e[i] *= 0.5;
