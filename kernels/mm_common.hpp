@@ -22,6 +22,19 @@ using VecD = std::array<Real, D>;
 // (MultimaterialStage) and a light node to USL (Stepper::usl_light_threshold).
 inline constexpr double kSliverMassFraction = 1e-6;
 
+// A rigid partner whose nodal domain fills less than this fraction of a cell
+// is taken as absent at the node under the displacement (and extrapolated)
+// separation: its surface lies about 0.65-0.7 h or more beyond the node
+// (a flat surface at distance s fills (1 - s)^2 / 2 of a linear hat, at any
+// angle), where only the overhang of its nearest particles reaches.
+// Without it, a rigid platen pressed into a body pins that body's nodes one
+// cell inside its surface, as the rigid's centre-of-mass velocity is its own
+// whatever its mass there (ALGORITHM §7): the body's last cell of particles
+// rode with the platen and the reaction read +h/(L - h) too stiff
+// (docs/contact_validation.md §11). The position method has its own gap test;
+// B-spline stencils do not use this one (MultimaterialStage::setup says why).
+inline constexpr double kRigidPresentFraction = 0.05;
+
 // Properties of one interacting material pair (one [[interaction]] of the scene).
 template <class Real>
 struct PairParams {
@@ -49,6 +62,9 @@ struct PairParams {
   // contact later (docs/contact_validation.md §4.3).
   Real contact_offset = Real(0.8);
   Real omega_min = 0;  // ABSOLUTE nodal domain below which the node is skipped (units of grid.vol)
+  // ABSOLUTE nodal domain of a rigid partner below which it is absent at the
+  // node (units of grid.vol; kRigidPresentFraction of a cell, 0 = no test).
+  Real rigid_min_volume = 0;
   bool force_limit = true;  // §4.4 (explicit integration only)
   Integration integration = Integration::explicit_;
   // The (P-20) area on domains with the opening closed (interface law only,

@@ -803,6 +803,98 @@ TEST(ValidationContact, RigidGripWorkIsExternalWork) {
   EXPECT_EQ(f.strain, 0.0);
 }
 
+// A rigid platen pressed into an elastic block (inputs/platen.toml,
+// docs/contact_validation.md §11): frictionless contact, free side, roller
+// base, so the block is in uniaxial stress and the platen's reaction is the
+// block's stiffness times its travel d: F = E' A d / L, with E' = E/(1 - nu^2)
+// in plane strain (A = 4 mm x 1 mm, L = 4 mm) and E in 3D (A = 2 x 2 mm).
+// h = 0.25 mm (L = 16 h), 2 ppc, d = 0.01 mm (4 % of a cell) at 1 ms;
+// tolerance 1 %. Before the rigid-presence test (kRigidPresentFraction),
+// uGIMP read +7.2 % (2D) and +7.6 % (3D): the platen's overhanging
+// particles made the nodes one cell inside the block contact nodes, and
+// the block's top cell rode with the platen (+h / (L - h) = +6.7 %).
+// The platen's reaction along `axis` after the step that reaches t = 1 ms.
+double platen_force_at_1ms(Simulation& sim, int axis) {
+  testing::run_until(sim, 1.0);
+  for (const Reaction& r : sim.reactions())
+    if (r.name == "rigid:platen") return r.force[std::size_t(axis)];
+  ADD_FAILURE() << "no reaction named rigid:platen";
+  return 0;
+}
+
+double platen_reaction_over_exact(const std::vector<std::string>& overrides) {
+  auto sim = make_simulation(parse_scene_file(input("platen.toml"), overrides));
+  const double force = platen_force_at_1ms(*sim, 1);
+  const double exact = 1000.0 / (1.0 - 0.3 * 0.3) * 4.0 * (0.01 * sim->time()) / 4.0;
+  return force / exact;
+}
+
+TEST(ValidationContact, RigidPlatenReactionIsTheBlocksStiffness) {
+  for (const char* shape : {"linear", "gimp"})
+    for (const char* separation : {"displacement", "position"}) {
+      const double ratio = platen_reaction_over_exact(
+          {std::string("grid.shape=\"") + shape + "\"",
+           std::string("interaction[0].separation=\"") + separation + "\""});
+      note("platen 2D %s %s: F / exact %.4f", shape, separation, ratio);
+      EXPECT_NEAR(ratio, 1.0, 0.01) << shape << " " << separation;
+    }
+}
+
+TEST(ValidationContact, RigidPlatenReactionIsTheBlocksStiffness3D) {
+  const std::string scene = R"(
+[simulation]
+dimension = 3
+end_time = 1.0
+cfl = 0.5
+[grid]
+origin = [-1.0, -1.0, -1.0]
+cell = [0.25, 0.25, 0.25]
+cells = [16, 16, 28]
+shape = "gimp"
+[[material]]
+name = "block"
+type = "isotropic"
+density = 1.0e-3
+E = 1000.0
+nu = 0.3
+[[material]]
+name = "platen"
+type = "rigid"
+density = 1.0e-3
+velocity = [0.0, 0.0, -0.01]
+[[body]]
+name = "block"
+material = "block"
+shape = "box"
+min = [0.0, 0.0, 0.0]
+max = [2.0, 2.0, 4.0]
+[[body]]
+name = "platen"
+material = "platen"
+shape = "box"
+min = [-0.5, -0.5, 4.0]
+max = [2.75, 2.75, 4.5]
+[[interaction]]
+materials = ["block", "platen"]
+law = "frictionless"
+normal = "rigid"
+[[boundary]]
+where = { min = [-1.0, -1.0, -1.0], max = [3.0, 3.0, 0.0] }
+fix = ["z"]
+[[boundary]]
+where = { min = [-1.0, -1.0, -1.0], max = [0.0, 3.0, 6.0] }
+fix = ["x"]
+[[boundary]]
+where = { min = [-1.0, -1.0, -1.0], max = [3.0, 0.0, 6.0] }
+fix = ["y"]
+)";
+  auto sim = testing::make_from_text(scene);
+  const double force = platen_force_at_1ms(*sim, 2);
+  const double exact = 1000.0 * 4.0 * (0.01 * sim->time()) / 4.0;
+  note("platen 3D gimp displacement: F / exact %.4f", force / exact);
+  EXPECT_NEAR(force / exact, 1.0, 0.01);
+}
+
 // ---------------------------------------------------------------------------
 // Refinement (ctest -L long)
 // ---------------------------------------------------------------------------

@@ -47,6 +47,15 @@ class MultimaterialStage {
       pp.separation = it.separation;
       pp.contact_offset = Real(it.contact_offset);
       pp.omega_min = Real(it.min_volume * cell);
+      // A rigid partner's presence (kRigidPresentFraction): for the cell-pair
+      // stencils only. A B-spline reaches one cell beyond a flush surface
+      // from the first step, so there the displacement method's premise
+      // (both materials at the node from the start) holds; with the test the
+      // platen read further from exact, not nearer (docs/contact_validation.md §11).
+      const bool cell_stencil =
+          scene.grid.shape == ShapeKind::linear || scene.grid.shape == ShapeKind::gimp;
+      if (it.separation != Separation::position && cell_stencil)
+        pp.rigid_min_volume = Real(kRigidPresentFraction * cell);
       pp.force_limit = it.force_limit;
       pp.integration = it.integration;
       pp.closed_area = it.law == Law::interface && it.area == ContactArea::closed;
