@@ -813,6 +813,7 @@ TEST(ValidationContact, RigidGripWorkIsExternalWork) {
 // uGIMP read +7.2 % (2D) and +7.6 % (3D): the platen's overhanging
 // particles made the nodes one cell inside the block contact nodes, and
 // the block's top cell rode with the platen (+h / (L - h) = +6.7 %).
+
 // The platen's reaction along `axis` after the step that reaches t = 1 ms.
 double platen_force_at_1ms(Simulation& sim, int axis) {
   testing::run_until(sim, 1.0);
