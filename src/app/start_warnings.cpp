@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "kernels/shape.hpp"
 #include "scene/format.hpp"
 #include "scene/interaction_warning.hpp"
 #include "scene/unused_keys.hpp"
@@ -67,33 +68,40 @@ std::vector<std::string> computed_normal_warnings(const Scene& scene) {
 }
 
 // Where two bodies meet on a grid line, each one's particles that reach a
-// node on it have their mass centroid c(shape, n) h from it: the 1D weights
-// of the rows n per cell within reach (uGIMP weighs rows seeded inside a
-// cell as the hat does). The position method reads the pair as c_a + c_b
-// apart; below contact_offset it registers contact. Linear and uGIMP at 2
-// per cell: 0.75 (the paper's 0.8 sits above it); 1 per cell, and every
-// B-spline case, lie above 0.8 (docs/contact_validation.md §11).
-double touching_centroid_distance(ShapeKind shape, int per_cell) {
-  auto weight = [shape](double x) {
-    x = std::abs(x);
-    switch (shape) {
-      case ShapeKind::bspline2:
-        return x < 0.5 ? 0.75 - x * x : x < 1.5 ? 0.5 * (1.5 - x) * (1.5 - x) : 0.0;
-      case ShapeKind::bspline3:
-        return x < 1   ? 2.0 / 3.0 - x * x + 0.5 * x * x * x
-               : x < 2 ? (2 - x) * (2 - x) * (2 - x) / 6
-                       : 0.0;
-      default:
-        return x < 1 ? 1 - x : 0.0;
-    }
-  };
+// node on it have their mass centroid c(shape, n) h from it: the weights
+// (kernels/shape.hpp, uGIMP with the half-width of n per cell) of the rows
+// seeded n per cell within two cells of the node. The position method reads
+// the pair as c_a + c_b apart; below contact_offset it registers contact.
+// Linear and uGIMP at 2 per cell: 0.75 (the paper's 0.8 sits above it);
+// 1 per cell, and every B-spline case, lie above 0.8
+// (docs/contact_validation.md §11).
+template <class Shape>
+double touching_centroid_distance(int per_cell) {
+  const double half_width = 0.5 / per_cell;
   double sum = 0, moment = 0;
-  for (int k = 0; k < 2 * per_cell; ++k) {  // every row within 2 cells
-    const double x = (k + 0.5) / per_cell;
-    sum += weight(x);
-    moment += weight(x) * x;
+  for (int k = 0; k < 2 * per_cell; ++k) {
+    const double x = (k + 0.5) / per_cell;  // the row's distance from the node
+    double w[Shape::S], dw[Shape::S];
+    const int base = Shape::eval(x, half_width, w, dw);  // node 0 is window entry -base
+    if (base > 0 || -base >= Shape::S) continue;
+    sum += w[-base];
+    moment += w[-base] * x;
   }
   return moment / sum;
+}
+
+double touching_centroid_distance(ShapeKind shape, int per_cell) {
+  switch (shape) {
+    case ShapeKind::linear:
+      return touching_centroid_distance<LinearShape>(per_cell);
+    case ShapeKind::gimp:
+      return touching_centroid_distance<GimpShape>(per_cell);
+    case ShapeKind::bspline2:
+      return touching_centroid_distance<BSpline2Shape>(per_cell);
+    case ShapeKind::bspline3:
+      return touching_centroid_distance<BSpline3Shape>(per_cell);
+  }
+  return 0;
 }
 
 std::vector<std::string> position_offset_warnings(const Scene& scene) {
