@@ -3,6 +3,7 @@
 // ALGORITHM §3-§7. Header-only, no allocation, no I/O.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -138,6 +139,16 @@ inline constexpr unsigned char kStickBoth = 4;
 // updated ones. Before, the stick held a closed gap shut while the bodies pulled apart
 // (the bouncing bars of §4.1).
 inline constexpr unsigned char kOneSidedNormal = 8;
+// Set by pass B after the momentum update where it applied a contact law, or stuck a
+// one-sided normal: the pair was held against approach there, and the particles moved
+// with that. MUSL's repeat of pass B on the re-extrapolated momenta (the strain's
+// velocities) holds these pairs too, even where the new momenta part; elsewhere it
+// decides on approach as pass B does. Why: the re-extrapolated relative velocity of a
+// pressed pair is noise of either sign, and a repeat that only stops approach let the
+// strain see every parting the particles never made. Under pure FLIP that noise is
+// kept, the strain fell behind the motion step by step, and a platen pressed into a
+// block read 0.1-2.1 of its reaction (docs/contact_validation.md §12).
+inline constexpr unsigned char kHeldInPassB = 16;
 
 // The stick flags with a one-sided normal decided by whether the pair approaches.
 inline unsigned char resolve_one_sided(unsigned char stick, bool approaching) {

@@ -47,7 +47,9 @@ inline Real corrected_normal_separation(Separation method, Real delta_n, Real h_
 // unit normal a → b. stick: Δp_a; frictionless: (Δp_a·n) n; Coulomb (P-16): with
 // d_n = Δp_a·n < 0, d_t = |Δp_a − d_n n|, t the unit tangential part: slides when
 // d_t > −μ d_n and then gets d_n n − μ d_n t (tangential change capped at μ|d_n|),
-// otherwise sticks. Any other law changes nothing.
+// otherwise sticks. A pair held while parting (d_n ≥ 0, kHeldInPassB) has no normal
+// push to carry friction: the cap is 0 and only the normal part changes. Any other law
+// changes nothing.
 template <int D, class Real>
 VecD<D, Real> contact_momentum_change(Law law, Real friction, const VecD<D, Real>& dp,
                                       const VecD<D, Real>& n) {
@@ -61,8 +63,9 @@ VecD<D, Real> contact_momentum_change(Law law, Real friction, const VecD<D, Real
     case Law::friction: {
       const VecD<D, Real> dp_t = add_scaled<D, Real>(dp, n, -dn);
       const Real dt_len = std::sqrt(dot<D, Real>(dp_t, dp_t));
-      if (dt_len > -friction * dn) {  // sliding; dt_len > 0 here since −μ d_n ≥ 0
-        const Real cap_over_len = -friction * dn / dt_len;
+      const Real cap = std::max(Real(0), -friction * dn);
+      if (dt_len > cap) {  // sliding; dt_len > 0 here since cap ≥ 0
+        const Real cap_over_len = cap / dt_len;
         return add_scaled<D, Real>(scaled<D, Real>(n, dn), dp_t, cap_over_len);
       }
       return dp;

@@ -62,6 +62,10 @@ struct PairBatch {
   // Pass B's scratch (interface law): 1 where the stick flags stick the
   // tangential direction, else 0 (see pass_b_lanes).
   alignas(64) Real sticks_tangential[kLanes];
+  // Pass B: in, 1 where the pair is held (kHeldInPassB, MUSL's strain pass
+  // only); out, 1 where this pass held it (contact applied, one-sided
+  // normal stuck), else 0.
+  alignas(64) Real held[kLanes];
 
   // Outputs for field_a (field_b gets the negatives).
   alignas(64) Real change[D][kLanes];
@@ -180,8 +184,9 @@ inline VecD<D, Real> contact_change_lane(bool contact, Real friction, const VecD
     VecD<D, Real> dp_t;
     for (int d = 0; d < D; ++d) dp_t[d] = dp[d] + -dn * n[d];
     const Real dt_len = std::sqrt(dot<D, Real>(dp_t, dp_t));
-    const bool slide = dt_len > -friction * dn;
-    const Real cap_over_len = -friction * dn / dt_len;
+    const Real cap = std::max(Real(0), -friction * dn);  // 0 for a held pair parting
+    const bool slide = dt_len > cap;
+    const Real cap_over_len = cap / dt_len;
     for (int d = 0; d < D; ++d) {
       const Real along = n[d] * dn;
       r[d] = slide ? along + cap_over_len * dp_t[d] : dp[d];
@@ -370,11 +375,16 @@ template <NormalMethod M, Law L, bool UseDf, bool Closed, int D, class Real>
 
 // Pass B on the lanes of B from pass A's saved normal and separation (B.n,
 // B.dn) and stick flags (B.stick): interact_pass_b_saved lane by lane.
+// strain_pass: MUSL's repeat, which holds the pairs B.stick marks
+// kHeldInPassB. B.held: which pairs this pass held.
 // flatten: as pass_a_lanes.
 template <Law L, int D, class Real>
-[[gnu::flatten]] void pass_b_lanes(PairBatch<D, Real>& B) {
+[[gnu::flatten]] void pass_b_lanes(PairBatch<D, Real>& B, bool strain_pass) {
   const Real friction = B.params->friction;
   const int count = B.count;
+  // As a 0/1 Real, for the reason given for sticks_tangential below.
+  for (int i = 0; i < count; ++i)
+    B.held[i] = strain_pass && (B.stick[i] & kHeldInPassB) != 0 ? Real(1) : Real(0);
   if constexpr (L == Law::interface) {
     // The tangential stick flag as a 0/1 Real in memory, for the loop below
     // to select on. A select on a test of the byte needs the byte lanes'
@@ -405,13 +415,16 @@ template <Law L, int D, class Real>
       const unsigned s = B.stick[i];
       const Real stuck = Real((s | (s >> 2)) & 1u);  // normal or both
       const Real one_sided = Real((s >> 3) & 1u);
-      const Real approaching = dot<D, Real>(dp, n) < 0 ? Real(1) : Real(0);
+      const Real approaching = dot<D, Real>(dp, n) < 0 ? Real(1) : B.held[i];
       const Real normal = stuck + one_sided * (approaching - stuck);
       const Real tangential = B.sticks_tangential[i];
       change = stick_change_lane<D, Real>(normal != Real(0), tangential != Real(0), dp, n);
+      B.held[i] = one_sided * approaching;
     } else {
-      const bool contact = (dot<D, Real>(dp, n) < 0) & (B.dn[i] < 0);  // in_contact
+      const bool contact =
+          ((dot<D, Real>(dp, n) < 0) & (B.dn[i] < 0)) | (B.held[i] != Real(0));  // in_contact
       change = contact_change_lane<L, D, Real>(contact, friction, dp, n);
+      B.held[i] = contact ? Real(1) : Real(0);
     }
     for (int d = 0; d < D; ++d) B.change[d][i] = has_normal ? change[d] : Real(0);
   }
@@ -465,16 +478,16 @@ void pass_a_batch(PairBatch<D, Real>& B, const std::array<Real, 3>& h, Real dt, 
 }
 
 template <int D, class Real>
-void pass_b_batch(PairBatch<D, Real>& B) {
+void pass_b_batch(PairBatch<D, Real>& B, bool strain_pass) {
   switch (B.params->law) {
     case Law::stick:
-      return pass_b_lanes<Law::stick>(B);
+      return pass_b_lanes<Law::stick>(B, strain_pass);
     case Law::frictionless:
-      return pass_b_lanes<Law::frictionless>(B);
+      return pass_b_lanes<Law::frictionless>(B, strain_pass);
     case Law::friction:
-      return pass_b_lanes<Law::friction>(B);
+      return pass_b_lanes<Law::friction>(B, strain_pass);
     default:
-      return pass_b_lanes<Law::interface>(B);
+      return pass_b_lanes<Law::interface>(B, strain_pass);
   }
 }
 

@@ -63,6 +63,7 @@ struct InteractionResult {
   unsigned char stick = 0;          // kStick* bits of interface directions made stick
   int limited = 0;                  // directions converted to stick by §4.4 / §4.5
   bool evaluated = false;           // false: screened (§3 Ω_min) or no normal
+  bool held = false;  // pass B: a contact law applied, or a one-sided normal stuck (kHeldInPassB)
 };
 
 // Geometry and kinematics of a pair at a node (§3, P-7 … P-15).
@@ -366,11 +367,27 @@ PairGeometry<D, Real> screened_geometry(const MaterialSide<D, Real>& a,
 
 template <int D, class Real>
 InteractionResult<D, Real> contact_result(const PairGeometry<D, Real>& G,
-                                          const PairParams<Real>& pp, Real corrected_dn) {
+                                          const PairParams<Real>& pp, Real corrected_dn,
+                                          bool held_before = false) {
   InteractionResult<D, Real> r;
   r.evaluated = true;
-  if (in_contact(dot<D, Real>(G.dp, G.n), corrected_dn))
-    r.momentum_change = contact_momentum_change<D, Real>(pp.law, pp.friction, G.dp, G.n);
+  r.held = held_before || in_contact(dot<D, Real>(G.dp, G.n), corrected_dn);
+  if (r.held) r.momentum_change = contact_momentum_change<D, Real>(pp.law, pp.friction, G.dp, G.n);
+  return r;
+}
+
+// Pass B's stick directions on its momenta: a one-sided normal sticks while the pair
+// approaches, or (MUSL's strain pass) where pass B held it (kHeldInPassB).
+template <int D, class Real>
+InteractionResult<D, Real> interface_stick_result(const PairGeometry<D, Real>& G,
+                                                  unsigned char stick_flags, bool strain_pass) {
+  InteractionResult<D, Real> r;
+  r.evaluated = true;
+  const bool held_before = strain_pass && (stick_flags & kHeldInPassB) != 0;
+  const unsigned char stick =
+      resolve_one_sided(stick_flags, held_before || dot<D, Real>(G.dp, G.n) < 0);
+  r.held = (stick & kOneSidedNormal) != 0 && (stick & kStickNormal) != 0;
+  r.momentum_change = directional_stick_change<D, Real>(stick, G.dp, G.n);
   return r;
 }
 
@@ -432,14 +449,15 @@ InteractionResult<D, Real> interact_pass_a(const MaterialSide<D, Real>& a,
 }
 
 // Pass B for material a against (virtual) b: contact on the updated momenta, or stick
-// re-applied along the interface directions flagged in pass A.
+// re-applied along the interface directions flagged in pass A. strain_pass: MUSL's
+// repeat, which also holds the pairs pass B held (kHeldInPassB).
 template <int D, class Real>
 InteractionResult<D, Real> interact_pass_b(const MaterialSide<D, Real>& a,
                                            const MaterialSide<D, Real>& b, bool b_is_rigid,
                                            const PairParams<Real>& pp, Real sign,
                                            const std::array<Real, 3>& node_position,
-                                           const std::array<Real, 3>& h,
-                                           unsigned char stick_flags) {
+                                           const std::array<Real, 3>& h, unsigned char stick_flags,
+                                           bool strain_pass) {
   InteractionResult<D, Real> r;
   if (pp.law == Law::interface && stick_flags == 0) return r;
   const PairGeometry<D, Real> G =
@@ -447,11 +465,9 @@ InteractionResult<D, Real> interact_pass_b(const MaterialSide<D, Real>& a,
   if (!G.valid) return r;
   if (pp.law != Law::interface)
     return contact_result<D, Real>(
-        G, pp, corrected_normal_separation(pp.separation, G.delta_n, G.h_perp, pp.contact_offset));
-  r.evaluated = true;
-  r.momentum_change = directional_stick_change<D, Real>(
-      resolve_one_sided(stick_flags, dot<D, Real>(G.dp, G.n) < 0), G.dp, G.n);
-  return r;
+        G, pp, corrected_normal_separation(pp.separation, G.delta_n, G.h_perp, pp.contact_offset),
+        strain_pass && (stick_flags & kHeldInPassB) != 0);
+  return interface_stick_result<D, Real>(G, stick_flags, strain_pass);
 }
 
 // Pass B from pass A's saved geometry: the same outcome as interact_pass_b
@@ -462,18 +478,17 @@ InteractionResult<D, Real> interact_pass_b_saved(const MaterialSide<D, Real>& a,
                                                  const MaterialSide<D, Real>& b, bool b_is_rigid,
                                                  const PairParams<Real>& pp,
                                                  const SavedGeometry<D, Real>& saved,
-                                                 unsigned char stick_flags) {
+                                                 unsigned char stick_flags, bool strain_pass) {
   InteractionResult<D, Real> r;
   if (pp.law == Law::interface && stick_flags == 0) return r;
   if (dot<D, Real>(saved.n, saved.n) == Real(0)) return r;
   PairGeometry<D, Real> G;
   G.n = saved.n;
   G.dp = momentum_change_to_center_of_mass<D, Real>(a.m, a.p, b.m, b.p, b_is_rigid);
-  if (pp.law != Law::interface) return contact_result<D, Real>(G, pp, saved.dn);
-  r.evaluated = true;
-  r.momentum_change = directional_stick_change<D, Real>(
-      resolve_one_sided(stick_flags, dot<D, Real>(G.dp, G.n) < 0), G.dp, G.n);
-  return r;
+  if (pp.law != Law::interface)
+    return contact_result<D, Real>(G, pp, saved.dn,
+                                   strain_pass && (stick_flags & kHeldInPassB) != 0);
+  return interface_stick_result<D, Real>(G, stick_flags, strain_pass);
 }
 
 // The fields present at a node, gathered into contiguous local arrays.
@@ -564,13 +579,21 @@ inline VecD<D, Real> reaction_change(const InteractionResult<D, Real>& r) {
   return r.momentum_change;
 }
 
-// One node of the list, pass A (kPassA) or pass B.
+// Pass B's record in the stick flags of which pairs it held (kHeldInPassB).
+inline void record_held(unsigned char* flags_out, std::size_t slot, bool held) {
+  if (!flags_out) return;
+  flags_out[slot] = (unsigned char)((flags_out[slot] & ~kHeldInPassB) | (held ? kHeldInPassB : 0));
+}
+
+// One node of the list, pass A (kPassA) or pass B. Pass B records in flags_out
+// (when given, the array flags_in points to) which pairs it held; strain_pass
+// (MUSL's repeat of pass B) holds them again.
 template <int D, class Real, bool kPassA>
 void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::size_t k,
                   std::size_t node, const PassNeeds& needs, NodeFields<D, Real>& nf,
                   const unsigned char* flags_in, unsigned char* flags_out,
                   const SavedGeometry<D, Real>* geometry_in, SavedGeometry<D, Real>* geometry_out,
-                  ChunkStats& cs) {
+                  bool strain_pass, ChunkStats& cs) {
   const int F = cfg.fields;
   gather_node<D, Real>(grid, node, cfg.mass_threshold, needs, nf);
   const int K = nf.count;
@@ -596,8 +619,10 @@ void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::si
                                       geometry_out ? &geometry_out[slot] : nullptr);
     } else {
       if (geometry_in)
-        return interact_pass_b_saved<D, Real>(a, b, b_rigid, pp, geometry_in[slot], flags_in[slot]);
-      return interact_pass_b<D, Real>(a, b, b_rigid, pp, sign, x_node, grid.h, flags_in[slot]);
+        return interact_pass_b_saved<D, Real>(a, b, b_rigid, pp, geometry_in[slot], flags_in[slot],
+                                              strain_pass);
+      return interact_pass_b<D, Real>(a, b, b_rigid, pp, sign, x_node, grid.h, flags_in[slot],
+                                      strain_pass);
     }
   };
   auto apply = [&](int field, const VecD<D, Real>& dp, const VecD<D, Real>& force, Real s) {
@@ -628,6 +653,8 @@ void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::si
       cs.energy += r.energy;
       cs.limited += r.limited;
       flags_out[k * std::size_t(F) + std::size_t(fa)] = r.stick;
+    } else {
+      record_held(flags_out, k * std::size_t(F) + std::size_t(fa), r.held);
     }
     return;
   }
@@ -673,6 +700,8 @@ void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::si
       }
       cs.limited += r.limited;
       flags_out[k * std::size_t(F) + std::size_t(fa)] = r.stick;
+    } else {
+      record_held(flags_out, k * std::size_t(F) + std::size_t(fa), r.held);
     }
   }
   for (int ia = 0; ia < K; ++ia) apply(nf.field[ia], change[ia], force[ia], Real(1));
@@ -767,10 +796,10 @@ void process_chunk(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg,
                    const unsigned char* flags_in, unsigned char* flags_out,
                    const SavedGeometry<D, Real>* geometry_in, SavedGeometry<D, Real>* geometry_out,
                    const SavedBatch<D, Real>* saved_in, SavedBatch<D, Real>* saved_out,
-                   ChunkStats& cs) {
+                   bool strain_pass, ChunkStats& cs) {
   auto per_node = [&](std::size_t k) {
     process_node<D, Real, kPassA>(grid, cfg, k, list[k], needs, nf, flags_in, flags_out,
-                                  geometry_in, geometry_out, cs);
+                                  geometry_in, geometry_out, strain_pass, cs);
   };
   if (!cfg.batch_pairs || (!kPassA && !geometry_in)) {
     for (std::size_t k = begin; k < end; ++k) per_node(k);
@@ -781,10 +810,14 @@ void process_chunk(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg,
   signed char lane_of[PairBatch<D, Real>::kLanes];
   if (!kPassA && saved_in && saved_in->count > 0) {
     restore_batch<D, Real>(*saved_in, entries, B, lane_of);
+    if (strain_pass)  // pass B's kHeldInPassB bits, which the saved batch has not
+      for (std::size_t k = begin; k < end; ++k)
+        if (const int i = lane_of[k - begin]; i >= 0)
+          B.stick[i] = flags_in[k * std::size_t(cfg.fields) + std::size_t(B.field_a)];
     BatchNeeds bn;
     bn.mass = bn.vol = bn.geometry = false;
     gather_batch<D, Real>(grid, bn, B);
-    pass_b_batch<D, Real>(B);
+    pass_b_batch<D, Real>(B, strain_pass);
   } else {
     sort_chunk<D, Real, kPassA>(grid, cfg, list, begin, end, B, lane_of);
     if (B.count > 0) {
@@ -808,7 +841,7 @@ void process_chunk(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg,
           B.dn[i] = geometry_in[slot].dn;
           B.stick[i] = flags_in[slot];
         }
-        pass_b_batch<D, Real>(B);
+        pass_b_batch<D, Real>(B, strain_pass);
       }
     }
     if constexpr (kPassA) {
@@ -831,6 +864,9 @@ void process_chunk(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg,
       grid.p[d][at_a + node] += B.change[d][i];
       grid.p[d][at_b + node] += -B.change[d][i];
     }
+    if constexpr (!kPassA)
+      record_held(flags_out, k * std::size_t(cfg.fields) + std::size_t(B.field_a),
+                  B.held[i] != Real(0));
     if constexpr (kPassA) {
       if (with_force)
         for (int d = 0; d < D; ++d) {
@@ -861,7 +897,8 @@ template <int D, class Real, bool kPassA>
 void run_pass(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
               const MMConfig<D, Real>& cfg, MMStats& stats, const unsigned char* flags_in,
               unsigned char* flags_out, const PassAGeometry<D, Real>* saved_in,
-              PassAGeometry<D, Real>* saved_out, const NodeOwnership& own) {
+              PassAGeometry<D, Real>* saved_out, const NodeOwnership& own,
+              bool strain_pass = false) {
   assert(validate_multimaterial(grid, cfg) == nullptr);
   const int F = cfg.fields;
   if (stats.rigid_reaction.size() != std::size_t(F))
@@ -931,7 +968,7 @@ void run_pass(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
         process_chunk<D, Real, kPassA>(grid, cfg, list, c * kChunk, end, needs, nf, *batch,
                                        flags_in, flags_out, geometry_in, geometry_out,
                                        batches_in ? &batches_in[c] : nullptr,
-                                       batches_out ? &batches_out[c] : nullptr, local);
+                                       batches_out ? &batches_out[c] : nullptr, strain_pass, local);
         local.reaction = partial[c].reaction;
         std::copy(reaction.begin(), reaction.end(), local.reaction);
         partial[c] = local;
@@ -972,21 +1009,29 @@ void multimaterial_pass_a(GridView<D, Real>& grid, const std::vector<std::uint32
                                      geometry, own);
 }
 
+// Which momenta pass B works on: the updated ones (the particles take the result), or
+// MUSL's re-extrapolation of the updated particles (only the strain reads the result).
+enum class PassB : unsigned char { after_update, strain };
+
 // Pass B (ALGORITHM §2 step 5), after the grid momentum update, with the same list, the
 // same m, mx, vol, g and the stick_flags of pass A. No interface force, no energy.
 // With pass A's `geometry` it reads only m, vol and p at the nodes (only p at
 // pass A's batched nodes) and takes the normal and separation from pass A;
 // without, it recomputes them (the same values).
+// PassB::after_update marks in stick_flags the pairs it held (kHeldInPassB);
+// PassB::strain, MUSL's repeat on the re-extrapolated momenta, holds those again.
 template <int D, class Real>
 void multimaterial_pass_b(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
-                          const MMConfig<D, Real>& cfg,
-                          const std::vector<unsigned char>& stick_flags, MMStats& stats,
-                          const NodeOwnership& own = {},
-                          const PassAGeometry<D, Real>* geometry = nullptr) {
+                          const MMConfig<D, Real>& cfg, std::vector<unsigned char>& stick_flags,
+                          MMStats& stats, const NodeOwnership& own = {},
+                          const PassAGeometry<D, Real>* geometry = nullptr,
+                          PassB which = PassB::after_update) {
   assert(stick_flags.size() == list.size() * std::size_t(cfg.fields));
   assert(!geometry || geometry->nodes.size() == stick_flags.size());
-  mm_detail::run_pass<D, Real, false>(grid, list, cfg, stats, stick_flags.data(), nullptr, geometry,
-                                      nullptr, own);
+  const bool strain = which == PassB::strain;
+  mm_detail::run_pass<D, Real, false>(grid, list, cfg, stats, stick_flags.data(),
+                                      strain ? nullptr : stick_flags.data(), geometry, nullptr, own,
+                                      strain);
 }
 
 }  // namespace mmpm

@@ -65,10 +65,12 @@ void run_pass_a(TestGrid<D, Real>& grid, TestSetup<D, Real>& setup, MMStats& sta
 
 template <int D, class Real>
 void run_pass_b(TestGrid<D, Real>& grid, TestSetup<D, Real>& setup, MMStats& stats,
-                const std::vector<unsigned char>& flags, const mmpm::NodeOwnership& own = {}) {
+                std::vector<unsigned char>& flags, const mmpm::NodeOwnership& own = {},
+                mmpm::PassB which = mmpm::PassB::after_update) {
   std::vector<std::uint32_t> list;
   mmpm::find_multimaterial_nodes(grid.view, Real(1e-12), list, own);
-  mmpm::multimaterial_pass_b(grid.view, list, setup.config(), flags, stats, own);
+  mmpm::multimaterial_pass_b(grid.view, list, setup.config(), flags, stats, own,
+                             static_cast<const mmpm::PassAGeometry<D, Real>*>(nullptr), which);
 }
 
 // One node, two materials approaching along x (a = field 0 moving +x into b).
@@ -271,6 +273,55 @@ TEST(MultimaterialContact, PassBRedoesContactOnUpdatedMomenta) {
   run_pass_b(t.grid, t.setup, stats, flags);
   EXPECT_EQ(t.grid.momentum(0, 0, 0), before);
   EXPECT_EQ(stats.interface_energy, 0.0);
+}
+
+// MUSL's strain pass (PassB::strain) holds the pairs pass B held after the
+// momentum update, even where the re-extrapolated momenta part, and tests the
+// others on approach (docs/contact_validation.md §12). Frictionless: a's
+// normal velocity goes to the centre of mass's, its tangential one stays.
+TEST(MultimaterialContact, StrainPassHoldsThePairsPassBHeld) {
+  for (const bool held : {true, false}) {
+    TwoBodyNode t;
+    t.setup.connect(0, 1, contact_params<double>(Law::frictionless));
+    MMStats stats;
+    std::vector<unsigned char> flags;
+    run_pass_a(t.grid, t.setup, stats, flags);  // both at v_x = -0.2
+    // The update pushes a into b (held) or pulls it away (not held).
+    t.grid.p[0][t.grid.at(0, 0)] += held ? 1.0 : -1.0;
+    run_pass_b(t.grid, t.setup, stats, flags);
+    EXPECT_EQ((flags[0] & mmpm::kHeldInPassB) != 0, held);
+    // The re-extrapolation: a parts from b along x, and slides along y.
+    t.grid.p[0][t.grid.at(0, 0)] = 2.0 * -0.6;
+    t.grid.p[0][t.grid.at(1, 0)] = 3.0 * -0.2;
+    t.grid.p[1][t.grid.at(0, 0)] = 2.0 * 0.4;
+    run_pass_b(t.grid, t.setup, stats, flags, {}, mmpm::PassB::strain);
+    const double vcx = (2.0 * -0.6 + 3.0 * -0.2) / 5.0;
+    EXPECT_NEAR(t.grid.velocity(0, 0, 0), held ? vcx : -0.6, kTol) << held;
+    EXPECT_NEAR(t.grid.velocity(1, 0, 0), held ? vcx : -0.2, kTol) << held;
+    EXPECT_NEAR(t.grid.velocity(0, 0, 1), 0.4, kTol) << "tangential untouched";
+    EXPECT_EQ((flags[0] & mmpm::kHeldInPassB) != 0, held) << "the strain pass records nothing";
+  }
+}
+
+// A held Coulomb pair that parts has no normal push to carry friction: the
+// normal change only (the cap max(0, -mu d_n) is 0), whatever mu.
+TEST(MultimaterialContact, StrainPassHoldsAPartingCoulombPairWithoutFriction) {
+  TwoBodyNode t;
+  t.setup.connect(0, 1, contact_params<double>(Law::friction, 0.5));
+  MMStats stats;
+  std::vector<unsigned char> flags;
+  run_pass_a(t.grid, t.setup, stats, flags);
+  t.grid.p[0][t.grid.at(0, 0)] += 1.0;
+  run_pass_b(t.grid, t.setup, stats, flags);
+  ASSERT_NE(flags[0] & mmpm::kHeldInPassB, 0);
+  t.grid.p[0][t.grid.at(0, 0)] = 2.0 * -0.6;
+  t.grid.p[0][t.grid.at(1, 0)] = 3.0 * -0.2;
+  t.grid.p[1][t.grid.at(0, 0)] = 2.0 * 0.4;
+  t.grid.p[1][t.grid.at(1, 0)] = 3.0 * -0.1;
+  run_pass_b(t.grid, t.setup, stats, flags, {}, mmpm::PassB::strain);
+  EXPECT_NEAR(t.grid.velocity(0, 0, 0), (2.0 * -0.6 + 3.0 * -0.2) / 5.0, kTol);
+  EXPECT_NEAR(t.grid.velocity(0, 0, 1), 0.4, kTol);
+  EXPECT_NEAR(t.grid.velocity(1, 0, 1), -0.1, kTol);
 }
 
 // ------------------------------------------------------------------ conservation

@@ -623,7 +623,7 @@ TEST(ValidationContact, DiskRollsWithoutSlipping) {
 // alpha = -2 mu G cos(theta) / R (within 10 %), slower than rolling would need.
 TEST(ValidationContact, DiskSlidesWhenFrictionIsLow) {
   MMPM_KNOWN_LIMITATION(
-      "the sliding disk's spin-up is 51 % of mu m g cos(theta) R / I with MUSL "
+      "the sliding disk's spin-up is 67 % of mu m g cos(theta) R / I with MUSL "
       "(linear acceleration within 1 %): nodes ahead of the contact point count as "
       "in contact under the paper's offset 0.8 h and push up there "
       "(docs/contact_validation.md §4.3; DiskSpinUpFollowsTheContactOffset)");
@@ -744,6 +744,9 @@ TEST(ValidationContact, RotatedInclineWithComputedNormals) {
 // registers contact only nearer the contact point: at 0.6 h the spin-up is
 // within 10 % of the exact value, and the disk sinks deeper (the price).
 // h = 0.5 mm, mu = 0.05, the fit window of DiskSlidesWhenFrictionIsLow.
+// Measured 0.511 (0.8 h) and 0.993 (0.6 h) before MUSL's strain pass held
+// the pairs pass B held (kHeldInPassB, §12): that repeat's one-sided test was
+// a second brake. Now 0.665 and 0.956: the offset still holds a third back.
 TEST(ValidationContact, DiskSpinUpFollowsTheContactOffset) {
   double spin[2] = {0, 0}, sink[2] = {0, 0};
   const double offsets[2] = {0.8, 0.6};
@@ -759,7 +762,8 @@ TEST(ValidationContact, DiskSpinUpFollowsTheContactOffset) {
     EXPECT_NEAR(r.accel / sliding_accel(r), 1.0, 0.05) << "offset " << offsets[k];
   }
   EXPECT_NEAR(spin[1], 1.0, 0.10) << "spin-up with the offset 0.6 h";
-  EXPECT_GT(spin[1] - spin[0], 0.3) << "the offset must be what holds the spin back";
+  EXPECT_LT(spin[0], 0.75) << "the paper's offset holds the spin back";
+  EXPECT_GT(spin[1] - spin[0], 0.2) << "the offset must be what holds the spin back";
   EXPECT_GT(sink[1], sink[0] + 0.1) << "a later contact lets the disk sink deeper";
 }
 
@@ -894,6 +898,110 @@ fix = ["y"]
   const double exact = 1000.0 * 4.0 * (0.01 * sim->time()) / 4.0;
   note("platen 3D gimp displacement: F / exact %.4f", force / exact);
   EXPECT_NEAR(force / exact, 1.0, 0.01);
+}
+
+// §12 Pressed contact under MUSL and pure FLIP (docs/contact_validation.md
+// §12). MUSL repeats pass B on the re-extrapolated momenta, and the strain
+// reads its result. That repeat used to stop approach only. At a pressed
+// contact the re-extrapolated relative velocity is noise of either sign, so
+// the strain saw partings the particles never made; pure FLIP keeps the
+// noise, and the strain fell behind the motion step after step. Pass B now
+// marks the pairs it held and the repeat holds them too (kHeldInPassB).
+// Before, over the windows below: the stiff platen's drive read 0.47-2.09
+// of exact (kinetic / strain up to 0.09, 9 % of the work lost); the rigid
+// platen on a block of 1 particle per cell fell to 0.14-0.46 of exact.
+
+// The reaction named `name` along y over stiffness x travel (`speed` mm/ms), averaged
+// step by step over the windows [times[i-1], times[i]) (times[0]: the start). A mean
+// over a window, not one step's value: an undamped drive rings around the static
+// reaction (the stiff platen: +-3.4 % in the last 0.05 ms of 0.3, under USL +-1 %).
+std::vector<double> reaction_over_exact(Simulation& sim, const std::string& name,
+                                        const std::vector<double>& times, double stiffness,
+                                        double speed) {
+  std::vector<double> out;
+  testing::run_until(sim, times[0]);
+  for (std::size_t w = 1; w < times.size(); ++w) {
+    double sum = 0;
+    long steps = 0;
+    while (sim.time() < times[w] - 1e-9 * sim.dt()) {
+      sim.step();
+      double force = std::numeric_limits<double>::quiet_NaN();
+      for (const Reaction& r : sim.reactions())
+        if (r.name == name) force = std::abs(r.force[1]);
+      sum += force / (stiffness * speed * sim.time());
+      ++steps;
+    }
+    out.push_back(sum / double(steps));
+  }
+  return out;
+}
+
+// inputs/stiff_platen.toml: E 100000 against 1000 MPa, frictionless, linear
+// shapes, 2 ppc, h = 0.25 mm; the drive's reaction against the series
+// stiffness k = 1097.4 N/mm. Pushed 0.003 mm over 0.3 ms (the scene's speed;
+// the block's first mode is 0.014 ms). Tolerances: the reaction's mean over
+// each 0.05 ms from 0.1 ms within 1 % (measured within 0.1 %); kinetic energy
+// under 1e-3 of the strain energy; the energy balance within 1e-3 of the work.
+TEST(ValidationContact, StiffPlatenUnderPureFlipReadsTheSeriesStiffness) {
+  const double k = 1.0 / (4.0 / (1000.0 / (1.0 - 0.3 * 0.3) * 4.0) + 0.5 / (1.0e5 * 4.0));
+  auto sim = make_simulation(parse_scene_file(
+      input("stiff_platen.toml"), {"boundary[2].displacement=[0.0, -0.003]", "boundary[2].ramp=0.3",
+                                   "simulation.end_time=0.3"}));
+  const std::vector<double> ratio =
+      reaction_over_exact(*sim, "plane_y=4.5", {0.1, 0.15, 0.2, 0.25, 0.3}, k, 0.01);
+  const Energies e = sim->energies();
+  const double balance = e.kinetic + e.strain + e.interface + e.damping - e.external_work;
+  note(
+      "stiff platen: F / exact, means over 0.05 ms from 0.1 ms: %.4f %.4f %.4f %.4f; kinetic / "
+      "strain %.3g, balance %.3g of W",
+      ratio[0], ratio[1], ratio[2], ratio[3], e.kinetic / e.strain, balance / e.external_work);
+  for (double r : ratio) EXPECT_NEAR(r, 1.0, 0.01);
+  EXPECT_LT(e.kinetic, 1e-3 * e.strain);
+  EXPECT_LT(std::abs(balance), 1e-3 * e.external_work);
+}
+
+// The same pair joined by a bilinear interface: perfect in compression (a
+// one-sided normal, which pass B holds as it holds contact), Dn = 10 MPa/mm
+// in tension, a perfect tangential direction (it keeps the block's top from
+// spreading, so the exact value is not the uniaxial one). USL has no repeat
+// of pass B; MUSL must read what USL reads, to 1 %, as the mean over
+// 0.2-0.3 ms. Before: MUSL read 0.17-2.04 of the uniaxial stiffness over 1 ms.
+TEST(ValidationContact, StiffPlatenOnAOneSidedInterfaceReadsAsUsl) {
+  const double k = 1.0 / (4.0 / (1000.0 / (1.0 - 0.3 * 0.3) * 4.0) + 0.5 / (1.0e5 * 4.0));
+  double ratio[2] = {0, 0};
+  const char* schemes[2] = {"MUSL", "USL"};
+  for (int s = 0; s < 2; ++s) {
+    auto sim = make_simulation(parse_scene_file(
+        input("stiff_platen.toml"),
+        {"boundary[2].displacement=[0.0, -0.003]", "boundary[2].ramp=0.3",
+         "simulation.end_time=0.3", std::string("simulation.scheme=\"") + schemes[s] + "\"",
+         "interaction[0].law=\"interface\"", "interaction[0].traction_law=\"bilinear\"",
+         "interaction[0].Dn=10.0", "interaction[0].Dt=\"perfect\"",
+         "interaction[0].normal=\"specified\"", "interaction[0].normal_vector=[0.0, 1.0]"}));
+    ratio[s] = reaction_over_exact(*sim, "plane_y=4.5", {0.2, 0.3}, k, 0.01)[0];
+    const Energies e = sim->energies();
+    note("stiff platen, one-sided interface, %s: F / uniaxial %.4f, kinetic / strain %.3g",
+         schemes[s], ratio[s], e.kinetic / e.strain);
+    EXPECT_LT(e.kinetic, 1e-3 * e.strain) << schemes[s];
+  }
+  EXPECT_NEAR(ratio[0] / ratio[1], 1.0, 0.01);
+}
+
+// inputs/platen.toml with the block seeded 1 particle per cell (the platen
+// keeps 2), MUSL, pure FLIP: the rigid platen's reaction, its means over
+// 0.4-0.5 and 0.9-1 ms, against E' A d / L, 1 %.
+TEST(ValidationContact, RigidPlatenOnOneParticlePerCellUnderPureFlip) {
+  const double k = 1000.0 / (1.0 - 0.3 * 0.3);
+  for (const char* shape : {"linear", "gimp"}) {
+    auto sim = make_simulation(parse_scene_file(
+        input("platen.toml"),
+        {std::string("grid.shape=\"") + shape + "\"", "body[0].particles_per_cell=1"}));
+    const std::vector<double> ratio =
+        reaction_over_exact(*sim, "rigid:platen", {0.4, 0.5, 0.9, 1.0}, k, 0.01);
+    note("platen, 1 ppc, %s: F / exact %.4f over 0.4-0.5 ms, %.4f over 0.9-1 ms", shape, ratio[0],
+         ratio[2]);
+    for (double r : ratio) EXPECT_NEAR(r, 1.0, 0.01) << shape;
+  }
 }
 
 // ---------------------------------------------------------------------------

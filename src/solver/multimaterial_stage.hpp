@@ -99,16 +99,18 @@ class MultimaterialStage {
     stats_.reset(fields_);
     multimaterial_pass_a(grid, list_, cfg_, stats_, stick_flags_, own, &geometry_);
   }
-  // record_reactions = false for MUSL's repeat of pass B on the
-  // re-extrapolated momenta: the step's impulse on rigid bodies is already counted.
-  void pass_b(GridView<D, Real>& grid, const NodeOwnership& own, bool record_reactions = true) {
+  // PassB::strain for MUSL's repeat of pass B on the re-extrapolated momenta:
+  // it holds the pairs the first pass B held (kHeldInPassB) and leaves the
+  // rigid reactions alone (the step's impulse on rigid bodies is already counted).
+  void pass_b(GridView<D, Real>& grid, const NodeOwnership& own,
+              PassB which = PassB::after_update) {
     if (!enabled_) return;
-    if (record_reactions) {
+    if (which == PassB::after_update) {
       multimaterial_pass_b(grid, list_, cfg_, stick_flags_, stats_, own, &geometry_);
       return;
     }
     const auto kept = stats_.rigid_reaction;
-    multimaterial_pass_b(grid, list_, cfg_, stick_flags_, stats_, own, &geometry_);
+    multimaterial_pass_b(grid, list_, cfg_, stick_flags_, stats_, own, &geometry_, PassB::strain);
     stats_.rigid_reaction = kept;
   }
 

@@ -1223,7 +1223,7 @@ void Stepper<D, Shape, Real>::step() {
     }
     if (mm) {
       tic();
-      mm_.pass_b(G_, own_, false);
+      mm_.pass_b(G_, own_, PassB::strain);
       toc(kStageMultimaterial);
     }
     tic();
