@@ -149,6 +149,11 @@ inline constexpr unsigned char kOneSidedNormal = 8;
 // kept, the strain fell behind the motion step by step, and a platen pressed into a
 // block read 0.1-2.1 of its reaction (docs/contact_validation.md §12).
 inline constexpr unsigned char kHeldInPassB = 16;
+// Whether pass B holds this pair regardless of approach: only in MUSL's strain pass,
+// and only where the pass B before it held the pair.
+inline bool held_before(unsigned char stick, bool strain_pass) {
+  return strain_pass && (stick & kHeldInPassB) != 0;
+}
 
 // The stick flags with a one-sided normal decided by whether the pair approaches.
 inline unsigned char resolve_one_sided(unsigned char stick, bool approaching) {

@@ -384,7 +384,7 @@ template <Law L, int D, class Real>
   const int count = B.count;
   // As a 0/1 Real, for the reason given for sticks_tangential below.
   for (int i = 0; i < count; ++i)
-    B.held[i] = strain_pass && (B.stick[i] & kHeldInPassB) != 0 ? Real(1) : Real(0);
+    B.held[i] = held_before(B.stick[i], strain_pass) ? Real(1) : Real(0);
   if constexpr (L == Law::interface) {
     // The tangential stick flag as a 0/1 Real in memory, for the loop below
     // to select on. A select on a test of the byte needs the byte lanes'

@@ -368,10 +368,10 @@ PairGeometry<D, Real> screened_geometry(const MaterialSide<D, Real>& a,
 template <int D, class Real>
 InteractionResult<D, Real> contact_result(const PairGeometry<D, Real>& G,
                                           const PairParams<Real>& pp, Real corrected_dn,
-                                          bool held_before = false) {
+                                          bool held_already = false) {
   InteractionResult<D, Real> r;
   r.evaluated = true;
-  r.held = held_before || in_contact(dot<D, Real>(G.dp, G.n), corrected_dn);
+  r.held = held_already || in_contact(dot<D, Real>(G.dp, G.n), corrected_dn);
   if (r.held) r.momentum_change = contact_momentum_change<D, Real>(pp.law, pp.friction, G.dp, G.n);
   return r;
 }
@@ -383,9 +383,8 @@ InteractionResult<D, Real> interface_stick_result(const PairGeometry<D, Real>& G
                                                   unsigned char stick_flags, bool strain_pass) {
   InteractionResult<D, Real> r;
   r.evaluated = true;
-  const bool held_before = strain_pass && (stick_flags & kHeldInPassB) != 0;
-  const unsigned char stick =
-      resolve_one_sided(stick_flags, held_before || dot<D, Real>(G.dp, G.n) < 0);
+  const unsigned char stick = resolve_one_sided(
+      stick_flags, held_before(stick_flags, strain_pass) || dot<D, Real>(G.dp, G.n) < 0);
   r.held = (stick & kOneSidedNormal) != 0 && (stick & kStickNormal) != 0;
   r.momentum_change = directional_stick_change<D, Real>(stick, G.dp, G.n);
   return r;
@@ -466,7 +465,7 @@ InteractionResult<D, Real> interact_pass_b(const MaterialSide<D, Real>& a,
   if (pp.law != Law::interface)
     return contact_result<D, Real>(
         G, pp, corrected_normal_separation(pp.separation, G.delta_n, G.h_perp, pp.contact_offset),
-        strain_pass && (stick_flags & kHeldInPassB) != 0);
+        held_before(stick_flags, strain_pass));
   return interface_stick_result<D, Real>(G, stick_flags, strain_pass);
 }
 
@@ -486,8 +485,7 @@ InteractionResult<D, Real> interact_pass_b_saved(const MaterialSide<D, Real>& a,
   G.n = saved.n;
   G.dp = momentum_change_to_center_of_mass<D, Real>(a.m, a.p, b.m, b.p, b_is_rigid);
   if (pp.law != Law::interface)
-    return contact_result<D, Real>(G, pp, saved.dn,
-                                   strain_pass && (stick_flags & kHeldInPassB) != 0);
+    return contact_result<D, Real>(G, pp, saved.dn, held_before(stick_flags, strain_pass));
   return interface_stick_result<D, Real>(G, stick_flags, strain_pass);
 }
 

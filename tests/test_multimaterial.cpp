@@ -275,6 +275,14 @@ TEST(MultimaterialContact, PassBRedoesContactOnUpdatedMomenta) {
   EXPECT_EQ(stats.interface_energy, 0.0);
 }
 
+// The node's momenta for velocities v_a of a (m = 2) and v_b of b (m = 3).
+void set_velocities(TwoBodyNode& t, std::array<double, 2> v_a, std::array<double, 2> v_b) {
+  for (int d = 0; d < 2; ++d) {
+    t.grid.p[d][t.grid.at(0, 0)] = 2.0 * v_a[std::size_t(d)];
+    t.grid.p[d][t.grid.at(1, 0)] = 3.0 * v_b[std::size_t(d)];
+  }
+}
+
 // MUSL's strain pass (PassB::strain) holds the pairs pass B held after the
 // momentum update, even where the re-extrapolated momenta part, and tests the
 // others on approach (docs/contact_validation.md §12). Frictionless: a's
@@ -291,9 +299,7 @@ TEST(MultimaterialContact, StrainPassHoldsThePairsPassBHeld) {
     run_pass_b(t.grid, t.setup, stats, flags);
     EXPECT_EQ((flags[0] & mmpm::kHeldInPassB) != 0, held);
     // The re-extrapolation: a parts from b along x, and slides along y.
-    t.grid.p[0][t.grid.at(0, 0)] = 2.0 * -0.6;
-    t.grid.p[0][t.grid.at(1, 0)] = 3.0 * -0.2;
-    t.grid.p[1][t.grid.at(0, 0)] = 2.0 * 0.4;
+    set_velocities(t, {-0.6, 0.4}, {-0.2, 0.5});
     run_pass_b(t.grid, t.setup, stats, flags, {}, mmpm::PassB::strain);
     const double vcx = (2.0 * -0.6 + 3.0 * -0.2) / 5.0;
     EXPECT_NEAR(t.grid.velocity(0, 0, 0), held ? vcx : -0.6, kTol) << held;
@@ -314,10 +320,7 @@ TEST(MultimaterialContact, StrainPassHoldsAPartingCoulombPairWithoutFriction) {
   t.grid.p[0][t.grid.at(0, 0)] += 1.0;
   run_pass_b(t.grid, t.setup, stats, flags);
   ASSERT_NE(flags[0] & mmpm::kHeldInPassB, 0);
-  t.grid.p[0][t.grid.at(0, 0)] = 2.0 * -0.6;
-  t.grid.p[0][t.grid.at(1, 0)] = 3.0 * -0.2;
-  t.grid.p[1][t.grid.at(0, 0)] = 2.0 * 0.4;
-  t.grid.p[1][t.grid.at(1, 0)] = 3.0 * -0.1;
+  set_velocities(t, {-0.6, 0.4}, {-0.2, -0.1});
   run_pass_b(t.grid, t.setup, stats, flags, {}, mmpm::PassB::strain);
   EXPECT_NEAR(t.grid.velocity(0, 0, 0), (2.0 * -0.6 + 3.0 * -0.2) / 5.0, kTol);
   EXPECT_NEAR(t.grid.velocity(0, 0, 1), 0.4, kTol);
