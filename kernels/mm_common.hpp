@@ -147,8 +147,18 @@ inline constexpr unsigned char kOneSidedNormal = 8;
 // pressed pair is noise of either sign, and a repeat that only stops approach let the
 // strain see every parting the particles never made. Under pure FLIP that noise is
 // kept, the strain fell behind the motion step by step, and a platen pressed into a
-// block read 0.1-2.1 of its reaction (docs/contact_validation.md §12).
+// block read 0.1-2.1 of its reaction (docs/contact_validation.md §12). USF's pass A,
+// whose momenta are the strain's velocities, holds the pairs the last step's pass B
+// held for the same reason (MultimaterialStage carries the bits from step to step;
+// docs/contact_validation.md §13).
 inline constexpr unsigned char kHeldInPassB = 16;
+// Set with kHeldInPassB where the held pair did not slide (the stick law, or Coulomb
+// friction inside its cone). USF's pass A sticks such a Coulomb pair: its extrapolated
+// momenta carry no normal push to bound the friction with (that comes with the
+// forces, in pass B), so the cone of its own let the strain slide where the bodies
+// stuck (a platen pressed through mu = 0.3 read 1.003-1.010 of the stiffness it has
+// stuck, 1.051; docs/contact_validation.md §13).
+inline constexpr unsigned char kStuckInPassB = 32;
 // Whether pass B holds this pair regardless of approach: only in MUSL's strain pass,
 // and only where the pass B before it held the pair.
 inline bool held_before(unsigned char stick, bool strain_pass) {

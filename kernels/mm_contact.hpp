@@ -49,30 +49,37 @@ inline Real corrected_normal_separation(Separation method, Real delta_n, Real h_
 // d_t > −μ d_n and then gets d_n n − μ d_n t (tangential change capped at μ|d_n|),
 // otherwise sticks. A pair held while parting (d_n ≥ 0, kHeldInPassB) has no normal
 // push to carry friction: the cap is 0 and only the normal part changes. Any other law
-// changes nothing.
+// changes nothing. *stuck (when given): whether the pair sticks (the stick law, or
+// Coulomb not sliding).
 template <int D, class Real>
 VecD<D, Real> contact_momentum_change(Law law, Real friction, const VecD<D, Real>& dp,
-                                      const VecD<D, Real>& n) {
+                                      const VecD<D, Real>& n, bool* stuck = nullptr) {
   using namespace mm_detail;
   const Real dn = dot<D, Real>(dp, n);
+  bool sticks = false;
+  VecD<D, Real> change{};
   switch (law) {
     case Law::stick:
-      return dp;
+      sticks = true;
+      change = dp;
+      break;
     case Law::frictionless:
-      return scaled<D, Real>(n, dn);
+      change = scaled<D, Real>(n, dn);
+      break;
     case Law::friction: {
       const VecD<D, Real> dp_t = add_scaled<D, Real>(dp, n, -dn);
       const Real dt_len = std::sqrt(dot<D, Real>(dp_t, dp_t));
       const Real cap = std::max(Real(0), -friction * dn);
-      if (dt_len > cap) {  // sliding; dt_len > 0 here since cap ≥ 0
-        const Real cap_over_len = cap / dt_len;
-        return add_scaled<D, Real>(scaled<D, Real>(n, dn), dp_t, cap_over_len);
-      }
-      return dp;
+      sticks = !(dt_len > cap);
+      // Sliding: dt_len > 0 there since cap ≥ 0.
+      change = sticks ? dp : add_scaled<D, Real>(scaled<D, Real>(n, dn), dp_t, cap / dt_len);
+      break;
     }
     default:
-      return VecD<D, Real>{};
+      break;
   }
+  if (stuck) *stuck = sticks;
+  return change;
 }
 
 // Stick along chosen directions (perfect or force-limited interface directions, §3.2,

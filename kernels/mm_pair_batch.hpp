@@ -62,10 +62,14 @@ struct PairBatch {
   // Pass B's scratch (interface law): 1 where the stick flags stick the
   // tangential direction, else 0 (see pass_b_lanes).
   alignas(64) Real sticks_tangential[kLanes];
+  // Pass A: in, 1 where the last step's pass B held the pair, 2 where it held
+  // it stuck (USF only).
   // Pass B: in, 1 where the pair is held (kHeldInPassB, MUSL's strain pass
   // only); out, 1 where this pass held it (contact applied, one-sided
   // normal stuck), else 0.
   alignas(64) Real held[kLanes];
+  // Pass B, out: 1 where this pass held the pair stuck (kStuckInPassB), else 0.
+  alignas(64) Real stuck[kLanes];
 
   // Outputs for field_a (field_b gets the negatives).
   alignas(64) Real change[D][kLanes];
@@ -170,14 +174,18 @@ inline VecD<D, Real> stick_change_lane(bool normal, bool tangential, const VecD<
   return r;
 }
 
-// contact_momentum_change for a law fixed at compile time, times "in contact".
+// contact_momentum_change for a law fixed at compile time, times "in contact";
+// stuck: 1 where the pair is in contact and sticks (stick law, Coulomb not
+// sliding), else 0.
 template <Law L, int D, class Real>
 inline VecD<D, Real> contact_change_lane(bool contact, Real friction, const VecD<D, Real>& dp,
-                                         const VecD<D, Real>& n) {
+                                         const VecD<D, Real>& n, Real& stuck) {
   const Real dn = dot<D, Real>(dp, n);
   VecD<D, Real> r;
+  stuck = Real(0);
   if constexpr (L == Law::stick) {
     r = dp;
+    stuck = contact ? Real(1) : Real(0);
   } else if constexpr (L == Law::frictionless) {
     for (int d = 0; d < D; ++d) r[d] = n[d] * dn;
   } else {  // Law::friction (P-16)
@@ -191,6 +199,7 @@ inline VecD<D, Real> contact_change_lane(bool contact, Real friction, const VecD
       const Real along = n[d] * dn;
       r[d] = slide ? along + cap_over_len * dp_t[d] : dp[d];
     }
+    stuck = contact & !slide ? Real(1) : Real(0);
   }
   for (int d = 0; d < D; ++d) r[d] = contact ? r[d] : Real(0);
   return r;
@@ -203,6 +212,29 @@ inline VecD<D, Real> lane(const Real* v, int i) {
   VecD<D, Real> r;
   for (int d = 0; d < D; ++d) r[d] = v[d * PairBatch<D, Real>::kLanes + i];
   return r;
+}
+
+// USF's pass A on the lanes the last step's pass B held (B.held: 1 held,
+// 2 held stuck), after pass_a_lanes' loop decided every lane on approach:
+// a held lane gets its contact change whatever the approach, and a Coulomb
+// lane held stuck the whole of Δp_a (contact_result's held_already and
+// stuck_already). A loop of its own: read in the lane loop, B.held left
+// GCC 12's 3D stick and frictionless loops scalar. B.n is 0 where pass A
+// found no usable normal, which it leaves alone.
+template <Law L, int D, class Real>
+void hold_carried_lanes(PairBatch<D, Real>& B) {
+  const Real friction = B.params->friction;
+  for (int i = 0; i < B.count; ++i) {
+    if (B.held[i] == Real(0)) continue;
+    const VecD<D, Real> n = lane<D, Real>(B.n[0], i);
+    if (dot<D, Real>(n, n) == Real(0)) continue;
+    const VecD<D, Real> dp = momentum_change_to_center_of_mass<D, Real>(
+        B.m[0][i], lane<D, Real>(B.p[0][0], i), B.m[1][i], lane<D, Real>(B.p[1][0], i), false);
+    Real stuck;
+    VecD<D, Real> change = contact_change_lane<L, D, Real>(true, friction, dp, n, stuck);
+    if (L == Law::friction && B.held[i] > Real(1)) change = dp;
+    for (int d = 0; d < D; ++d) B.change[d][i] = change[d];
+  }
 }
 
 // Pass A on the lanes of B: the normal by method M, the pair's law L
@@ -300,7 +332,9 @@ template <NormalMethod M, Law L, bool UseDf, bool Closed, int D, class Real>
     [[maybe_unused]] Real flags = 0;
     if constexpr (L != Law::interface) {
       // in_contact (P-9, P-12, P-14), with & on the masks.
-      change = contact_change_lane<L, D, Real>((dp_n < 0) & (dn < 0), friction, dp, n);
+      // USF's held pairs: hold_carried_lanes, after this loop.
+      [[maybe_unused]] Real stuck;
+      change = contact_change_lane<L, D, Real>((dp_n < 0) & (dn < 0), friction, dp, n, stuck);
     } else {
       // §3.2 traction (linear or bilinear), (P-20) area, §4.4 force limit.
       const Real Dn_now = bilinear & (dn < 0) ? Dn_compression : Dn;
@@ -340,7 +374,8 @@ template <NormalMethod M, Law L, bool UseDf, bool Closed, int D, class Real>
       // (kOneSidedNormal, docs/multimaterial.md §4.1): it sticks only while the
       // pair approaches and, released, exerts no force.
       const Real one_sided = pn * (bilinear & (dn < 0) ? one : none);
-      const Real released = one_sided * (dp_n < 0 ? none : one);
+      const Real approaching = dp_n < 0 ? one : B.held[i];  // or held (USF)
+      const Real released = one_sided * (one - approaching);
       const Real sn = pn + ln - released;
       flags = sn * Real(kStickNormal) + st * Real(kStickTangential) + sn * st * Real(kStickBoth) +
               one_sided * Real(kOneSidedNormal) + Real(16) * (ln + lt);
@@ -370,6 +405,7 @@ template <NormalMethod M, Law L, bool UseDf, bool Closed, int D, class Real>
       B.stick[i] = 0;
       B.limited[i] = 0;
     }
+    hold_carried_lanes<L>(B);
   }
 }
 
@@ -420,10 +456,11 @@ template <Law L, int D, class Real>
       const Real tangential = B.sticks_tangential[i];
       change = stick_change_lane<D, Real>(normal != Real(0), tangential != Real(0), dp, n);
       B.held[i] = one_sided * approaching;
+      B.stuck[i] = Real(0);
     } else {
       const bool contact =
           ((dot<D, Real>(dp, n) < 0) & (B.dn[i] < 0)) | (B.held[i] != Real(0));  // in_contact
-      change = contact_change_lane<L, D, Real>(contact, friction, dp, n);
+      change = contact_change_lane<L, D, Real>(contact, friction, dp, n, B.stuck[i]);
       B.held[i] = contact ? Real(1) : Real(0);
     }
     for (int d = 0; d < D; ++d) B.change[d][i] = has_normal ? change[d] : Real(0);

@@ -63,7 +63,8 @@ struct InteractionResult {
   unsigned char stick = 0;          // kStick* bits of interface directions made stick
   int limited = 0;                  // directions converted to stick by §4.4 / §4.5
   bool evaluated = false;           // false: screened (§3 Ω_min) or no normal
-  bool held = false;  // pass B: a contact law applied, or a one-sided normal stuck (kHeldInPassB)
+  bool held = false;   // pass B: a contact law applied, or a one-sided normal stuck (kHeldInPassB)
+  bool stuck = false;  // pass B: held by a contact that did not slide (kStuckInPassB)
 };
 
 // Geometry and kinematics of a pair at a node (§3, P-7 … P-15).
@@ -365,14 +366,18 @@ PairGeometry<D, Real> screened_geometry(const MaterialSide<D, Real>& a,
   return pair_geometry<D, Real>(a, b, b_is_rigid, pp, sign, node_position, h);
 }
 
+// held_already: hold the pair whatever the approach; stuck_already (with it): a
+// Coulomb pair sticks (USF's pass A, kStuckInPassB).
 template <int D, class Real>
 InteractionResult<D, Real> contact_result(const PairGeometry<D, Real>& G,
                                           const PairParams<Real>& pp, Real corrected_dn,
-                                          bool held_already = false) {
+                                          bool held_already = false, bool stuck_already = false) {
   InteractionResult<D, Real> r;
   r.evaluated = true;
   r.held = held_already || in_contact(dot<D, Real>(G.dp, G.n), corrected_dn);
-  if (r.held) r.momentum_change = contact_momentum_change<D, Real>(pp.law, pp.friction, G.dp, G.n);
+  if (!r.held) return r;
+  const Law law = held_already && stuck_already && pp.law == Law::friction ? Law::stick : pp.law;
+  r.momentum_change = contact_momentum_change<D, Real>(law, pp.friction, G.dp, G.n, &r.stuck);
   return r;
 }
 
@@ -390,15 +395,16 @@ InteractionResult<D, Real> interface_stick_result(const PairGeometry<D, Real>& G
   return r;
 }
 
-// Everything pass A does for material a against (virtual) b.
+// Everything pass A does for material a against (virtual) b. held_last_step: the last
+// step's pass B held this pair (USF only, kHeldInPassB): a contact or a one-sided normal
+// holds it again whatever the sign of the approach; stuck_last_step (kStuckInPassB):
+// a Coulomb pair sticks.
 template <int D, class Real>
-InteractionResult<D, Real> interact_pass_a(const MaterialSide<D, Real>& a,
-                                           const MaterialSide<D, Real>& b, bool b_is_rigid,
-                                           const PairParams<Real>& pp, Real sign,
-                                           const std::array<Real, 3>& node_position,
-                                           const std::array<Real, 3>& h, Real dt, Real limit_dt,
-                                           Real thickness, bool use_force_difference,
-                                           SavedGeometry<D, Real>* save) {
+InteractionResult<D, Real> interact_pass_a(
+    const MaterialSide<D, Real>& a, const MaterialSide<D, Real>& b, bool b_is_rigid,
+    const PairParams<Real>& pp, Real sign, const std::array<Real, 3>& node_position,
+    const std::array<Real, 3>& h, Real dt, Real limit_dt, Real thickness, bool use_force_difference,
+    SavedGeometry<D, Real>* save, bool held_last_step = false, bool stuck_last_step = false) {
   InteractionResult<D, Real> r;
   const PairGeometry<D, Real> G =
       screened_geometry<D, Real>(a, b, b_is_rigid, pp, sign, node_position, h);
@@ -409,7 +415,8 @@ InteractionResult<D, Real> interact_pass_a(const MaterialSide<D, Real>& a,
   const Real dn =
       corrected_normal_separation(pp.separation, G.delta_n, G.h_perp, pp.contact_offset);
   if (save) *save = SavedGeometry<D, Real>{G.n, dn};
-  if (pp.law != Law::interface) return contact_result<D, Real>(G, pp, dn);
+  if (pp.law != Law::interface)
+    return contact_result<D, Real>(G, pp, dn, held_last_step, stuck_last_step);
 
   r.evaluated = true;
   const Traction<Real> tr = evaluate_traction(pp, dn, G.delta_t);
@@ -439,7 +446,7 @@ InteractionResult<D, Real> interact_pass_a(const MaterialSide<D, Real>& a,
   // separates, as contact is (docs/multimaterial.md §4.1); perfect, it has no force or
   // energy to drop. Pass B resolves the flag the same way on its momenta.
   if (pp.traction_law == TractionLaw::bilinear && dn < 0 && tr.perfect_n)
-    r.stick = resolve_one_sided(r.stick | kOneSidedNormal, dp_n < 0);
+    r.stick = resolve_one_sided(r.stick | kOneSidedNormal, held_last_step || dp_n < 0);
   r.limited = int(on.limited) + int(ot.limited);
   r.momentum_change = directional_stick_change<D, Real>(r.stick, G.dp, G.n);
   for (int d = 0; d < D; ++d) r.force[d] = on.force * G.n[d] + ot.force * G.t[d];
@@ -577,10 +584,13 @@ inline VecD<D, Real> reaction_change(const InteractionResult<D, Real>& r) {
   return r.momentum_change;
 }
 
-// Pass B's record in the stick flags of which pairs it held (kHeldInPassB).
-inline void record_held(unsigned char* flags_out, std::size_t slot, bool held) {
+// Pass B's record in the stick flags of which pairs it held (kHeldInPassB) and
+// which of those stuck (kStuckInPassB).
+inline void record_held(unsigned char* flags_out, std::size_t slot, bool held, bool stuck) {
   if (!flags_out) return;
-  flags_out[slot] = (unsigned char)((flags_out[slot] & ~kHeldInPassB) | (held ? kHeldInPassB : 0));
+  const unsigned char bits =
+      (unsigned char)((held ? kHeldInPassB : 0) | (held && stuck ? kStuckInPassB : 0));
+  flags_out[slot] = (unsigned char)((flags_out[slot] & ~(kHeldInPassB | kStuckInPassB)) | bits);
 }
 
 // One node of the list, pass A (kPassA) or pass B. Pass B records in flags_out
@@ -612,9 +622,11 @@ void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::si
     const Real sign = field_a == pp.first_field ? Real(1) : Real(-1);
     const std::size_t slot = k * std::size_t(F) + std::size_t(field_a);
     if constexpr (kPassA) {
+      const unsigned char last = flags_in != nullptr ? flags_in[slot] : 0;
       return interact_pass_a<D, Real>(a, b, b_rigid, pp, sign, x_node, grid.h, cfg.dt,
                                       cfg.stick_dt(), cfg.thickness, cfg.use_force_difference,
-                                      geometry_out ? &geometry_out[slot] : nullptr);
+                                      geometry_out ? &geometry_out[slot] : nullptr,
+                                      (last & kHeldInPassB) != 0, (last & kStuckInPassB) != 0);
     } else {
       if (geometry_in)
         return interact_pass_b_saved<D, Real>(a, b, b_rigid, pp, geometry_in[slot], flags_in[slot],
@@ -652,7 +664,7 @@ void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::si
       cs.limited += r.limited;
       flags_out[k * std::size_t(F) + std::size_t(fa)] = r.stick;
     } else {
-      record_held(flags_out, k * std::size_t(F) + std::size_t(fa), r.held);
+      record_held(flags_out, k * std::size_t(F) + std::size_t(fa), r.held, r.stuck);
     }
     return;
   }
@@ -699,7 +711,7 @@ void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::si
       cs.limited += r.limited;
       flags_out[k * std::size_t(F) + std::size_t(fa)] = r.stick;
     } else {
-      record_held(flags_out, k * std::size_t(F) + std::size_t(fa), r.held);
+      record_held(flags_out, k * std::size_t(F) + std::size_t(fa), r.held, r.stuck);
     }
   }
   for (int ia = 0; ia < K; ++ia) apply(nf.field[ia], change[ia], force[ia], Real(1));
@@ -826,6 +838,17 @@ void process_chunk(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg,
         bn.position = method == NormalMethod::radial;
         bn.force = cfg.use_force_difference;
         gather_batch<D, Real>(grid, bn, B);
+        // USF's pairs the last step's pass B held (1) and held stuck (2)
+        // (multimaterial_pass_a).
+        for (std::size_t k = begin; k < end; ++k)
+          if (const int i = lane_of[k - begin]; i >= 0) {
+            const unsigned char last =
+                flags_in != nullptr ? flags_in[k * std::size_t(cfg.fields) + std::size_t(B.field_a)]
+                                    : 0;
+            B.held[i] = (last & kHeldInPassB) == 0    ? Real(0)
+                        : (last & kStuckInPassB) == 0 ? Real(1)
+                                                      : Real(2);
+          }
         // The lanes read dt in the force limit only (explicit integration).
         pass_a_batch<D, Real>(B, grid.h, cfg.stick_dt(), cfg.thickness, cfg.use_force_difference);
       } else {
@@ -864,7 +887,7 @@ void process_chunk(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg,
     }
     if constexpr (!kPassA)
       record_held(flags_out, k * std::size_t(cfg.fields) + std::size_t(B.field_a),
-                  B.held[i] != Real(0));
+                  B.held[i] != Real(0), B.stuck[i] != Real(0));
     if constexpr (kPassA) {
       if (with_force)
         for (int d = 0; d < D; ++d) {
@@ -992,19 +1015,23 @@ void run_pass(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
 // interaction computed for field a at node list[k]. `geometry`, when given, receives
 // each interaction's normal and corrected separation for pass B (PassAGeometry).
 // `own`: which thread starts on which nodes (kernels/node_ownership.hpp).
+// held_last_step (USF), when given: per entry [k*F + a] as stick_flags, the
+// kHeldInPassB and kStuckInPassB bits of the last step's pass B at node list[k];
+// those pairs are held, and a Coulomb pair held stuck sticks.
 template <int D, class Real>
 void multimaterial_pass_a(GridView<D, Real>& grid, const std::vector<std::uint32_t>& list,
                           const MMConfig<D, Real>& cfg, MMStats& stats,
                           std::vector<unsigned char>& stick_flags, const NodeOwnership& own = {},
-                          PassAGeometry<D, Real>* geometry = nullptr) {
+                          PassAGeometry<D, Real>* geometry = nullptr,
+                          const unsigned char* held_last_step = nullptr) {
   stick_flags.assign(list.size() * std::size_t(cfg.fields), 0);
   if (geometry) {
     constexpr std::size_t kChunk = mm_detail::PairBatch<D, Real>::kLanes;
     geometry->nodes.resize(list.size() * std::size_t(cfg.fields));
     geometry->batches.resize((list.size() + kChunk - 1) / kChunk);
   }
-  mm_detail::run_pass<D, Real, true>(grid, list, cfg, stats, nullptr, stick_flags.data(), nullptr,
-                                     geometry, own);
+  mm_detail::run_pass<D, Real, true>(grid, list, cfg, stats, held_last_step, stick_flags.data(),
+                                     nullptr, geometry, own);
 }
 
 // Which momenta pass B works on: the updated ones (the particles take the result), or

@@ -306,8 +306,10 @@ TEST(Determinism, ImperfectInterfaceFloat2D) {
   EXPECT_GT(r.counters.multimaterial_nodes, 0);
 }
 
-TEST(Determinism, FrictionContactTwoBlocksApproaching2D) {
+// Two blocks driven into each other through Coulomb contact, under `scheme`.
+void check_friction_contact(const std::string& scheme) {
   BoxScene2D s = two_materials("double", kFrictionContact);
+  s.scheme = scheme;
   // Leave a gap of one particle spacing less than a cell between the blocks.
   s.b1_min[0] = 34.5;
   s.b1_max[0] = 64.5;
@@ -337,6 +339,16 @@ TEST(Determinism, FrictionContactTwoBlocksApproaching2D) {
   EXPECT_GT(one.counters.multimaterial_nodes, 0) << "the blocks must be in contact";
   EXPECT_GT(one.energies.strain, 0.0) << "contact must have stressed the blocks";
   expect_identical(one, two);
+}
+
+TEST(Determinism, FrictionContactTwoBlocksApproaching2D) {
+  check_friction_contact("USL");
+}
+
+// USF carries the last pass B's held and stuck pairs into the next pass A
+// (docs/contact_validation.md §13).
+TEST(Determinism, FrictionContactTwoBlocksApproachingUSF2D) {
+  check_friction_contact("USF");
 }
 
 std::string scene_3d() {

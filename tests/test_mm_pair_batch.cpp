@@ -1,6 +1,7 @@
 // Two-material nodes in batches (kernels/mm_pair_batch.hpp) against the
 // per-node path of the multimaterial pass (kernels/multimaterial.hpp): the
-// same grids through pass A and MUSL's two passes B, with
+// same grids through pass A and MUSL's two passes B, then USF's next pass A
+// (holding what the last pass B held) and its pass B, with
 // MMConfig::batch_pairs on and off. Every law, normal method, traction law,
 // separation method, force limit on/off, Δf on/off, perfect and zero
 // stiffnesses, volume screening; 2D and 3D, double and float; and a grid of
@@ -65,11 +66,21 @@ Outcome run(TestGrid<D, Real>& grid, TestSetup<D, Real>& setup, bool batch,
   mmpm::PassAGeometry<D, Real>& geometry = reuse ? *reuse : fresh;
   mmpm::multimaterial_pass_a(grid.view, list, cfg, out.stats, out.flags, {}, &geometry);
   out.limited_total = out.stats.force_limited;
-  for (int pass = 0; pass < 2; ++pass) {  // MUSL: pass B after each transfer
+  auto update_then_pass_b = [&] {
     for (std::size_t i = 0; i < grid.p[0].size(); ++i)
       for (int d = 0; d < D; ++d) grid.p[d][i] += Real(0.02) * grid.f[d][i];
     mmpm::multimaterial_pass_b(grid.view, list, cfg, out.flags, out.stats, {}, &geometry);
-  }
+  };
+  for (int pass = 0; pass < 2; ++pass) update_then_pass_b();  // MUSL: after each transfer
+  // USF's next step on the same nodes: pass A holds the pairs the last pass B
+  // held (and sticks the Coulomb pairs it held stuck), from the momenta as they are.
+  std::vector<unsigned char> held(out.flags.size());
+  for (std::size_t k = 0; k < held.size(); ++k)
+    held[k] = out.flags[k] & (mmpm::kHeldInPassB | mmpm::kStuckInPassB);
+  mmpm::multimaterial_pass_a(grid.view, list, cfg, out.stats, out.flags, {}, &geometry,
+                             held.data());
+  out.limited_total = out.stats.force_limited;  // both passes A
+  update_then_pass_b();
   return out;
 }
 

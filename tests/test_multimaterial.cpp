@@ -55,12 +55,14 @@ PairParams<Real> interface_params(Real Dn, Real Dt) {
 template <int D, class Real>
 void run_pass_a(TestGrid<D, Real>& grid, TestSetup<D, Real>& setup, MMStats& stats,
                 std::vector<unsigned char>& flags, Real threshold = Real(1e-12),
-                const mmpm::NodeOwnership& own = {}) {
+                const mmpm::NodeOwnership& own = {},
+                const unsigned char* held_last_step = nullptr) {
   std::vector<std::uint32_t> list;
   mmpm::find_multimaterial_nodes(grid.view, threshold, list, own);
   ASSERT_EQ(mmpm::validate_multimaterial(grid.view, setup.config()), nullptr);
   stats.reset(setup.F);
-  mmpm::multimaterial_pass_a(grid.view, list, setup.config(), stats, flags, own);
+  mmpm::multimaterial_pass_a(grid.view, list, setup.config(), stats, flags, own,
+                             static_cast<mmpm::PassAGeometry<D, Real>*>(nullptr), held_last_step);
 }
 
 template <int D, class Real>
@@ -325,6 +327,65 @@ TEST(MultimaterialContact, StrainPassHoldsAPartingCoulombPairWithoutFriction) {
   EXPECT_NEAR(t.grid.velocity(0, 0, 0), (2.0 * -0.6 + 3.0 * -0.2) / 5.0, kTol);
   EXPECT_NEAR(t.grid.velocity(0, 0, 1), 0.4, kTol);
   EXPECT_NEAR(t.grid.velocity(1, 0, 1), -0.1, kTol);
+}
+
+// USF's pass A (docs/contact_validation.md §13) holds the pairs the last
+// step's pass B held, even where the extrapolated momenta part, and tests the
+// others on approach; the same through the SIMD lanes and the per-node path.
+// Frictionless: a's normal velocity goes to the centre of mass's, its
+// tangential one stays.
+TEST(MultimaterialContact, UsfPassAHoldsThePairsTheLastPassBHeld) {
+  for (const bool batch : {true, false})
+    for (const bool held : {true, false}) {
+      TwoBodyNode t;
+      t.setup.connect(0, 1, contact_params<double>(Law::frictionless));
+      t.setup.cfg.batch_pairs = batch;
+      MMStats stats;
+      std::vector<unsigned char> flags;
+      run_pass_a(t.grid, t.setup, stats, flags);
+      t.grid.p[0][t.grid.at(0, 0)] += held ? 1.0 : -1.0;  // pushes a into b, or away
+      run_pass_b(t.grid, t.setup, stats, flags);
+      ASSERT_EQ((flags[0] & mmpm::kHeldInPassB) != 0, held);
+      EXPECT_EQ(flags[0] & mmpm::kStuckInPassB, 0) << "frictionless never sticks";
+      // The next step's extrapolation: a parts from b along x, and slides along y.
+      const std::vector<unsigned char> last = flags;
+      set_velocities(t, {-0.6, 0.4}, {-0.2, 0.5});
+      run_pass_a(t.grid, t.setup, stats, flags, 1e-12, {}, last.data());
+      const double vcx = (2.0 * -0.6 + 3.0 * -0.2) / 5.0;
+      EXPECT_NEAR(t.grid.velocity(0, 0, 0), held ? vcx : -0.6, kTol) << held << batch;
+      EXPECT_NEAR(t.grid.velocity(1, 0, 0), held ? vcx : -0.2, kTol) << held << batch;
+      EXPECT_NEAR(t.grid.velocity(0, 0, 1), 0.4, kTol) << "tangential untouched";
+    }
+}
+
+// A Coulomb pair the last pass B held stuck sticks in USF's pass A, whatever
+// its extrapolated momenta: they carry no normal push to bound the friction
+// with (a pressed platen's top face slid in the strain and read 1.003-1.010
+// of the stuck stiffness, 1.051). Held sliding, it gets the normal change
+// only (the cap max(0, -mu d_n) of a parting pair is 0).
+TEST(MultimaterialContact, UsfPassASticksACoulombPairTheLastPassBHeldStuck) {
+  for (const bool batch : {true, false})
+    for (const bool stuck : {true, false}) {
+      TwoBodyNode t;
+      t.setup.connect(0, 1, contact_params<double>(Law::friction, 0.5));
+      t.setup.cfg.batch_pairs = batch;
+      MMStats stats;
+      std::vector<unsigned char> flags;
+      run_pass_a(t.grid, t.setup, stats, flags);  // both at (-0.2, 0.3)
+      // The update pushes a into b along x, and (not stuck) drags it hard along y.
+      t.grid.p[0][t.grid.at(0, 0)] += 1.0;
+      t.grid.p[1][t.grid.at(0, 0)] += stuck ? 0.1 : 4.0;
+      run_pass_b(t.grid, t.setup, stats, flags);
+      ASSERT_NE(flags[0] & mmpm::kHeldInPassB, 0);
+      ASSERT_EQ((flags[0] & mmpm::kStuckInPassB) != 0, stuck) << batch;
+      const std::vector<unsigned char> last = flags;
+      set_velocities(t, {-0.6, 0.4}, {-0.2, -0.1});  // parting along x, sliding along y
+      run_pass_a(t.grid, t.setup, stats, flags, 1e-12, {}, last.data());
+      const double vcx = (2.0 * -0.6 + 3.0 * -0.2) / 5.0, vcy = (2.0 * 0.4 + 3.0 * -0.1) / 5.0;
+      EXPECT_NEAR(t.grid.velocity(0, 0, 0), vcx, kTol) << stuck << batch;
+      EXPECT_NEAR(t.grid.velocity(0, 0, 1), stuck ? vcy : 0.4, kTol) << stuck << batch;
+      EXPECT_NEAR(t.grid.velocity(1, 0, 1), stuck ? vcy : -0.1, kTol) << stuck << batch;
+    }
 }
 
 // ------------------------------------------------------------------ conservation

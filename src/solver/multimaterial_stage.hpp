@@ -4,9 +4,12 @@
 // arrays, no work) when the scene has one material field.
 #pragma once
 
+#include <algorithm>
 #include <limits>
+#include <stdexcept>
 #include <vector>
 
+#include "io/checkpoint.hpp"
 #include "kernels/multimaterial.hpp"
 #include "scene/error.hpp"
 #include "solver/field_plan.hpp"
@@ -71,6 +74,8 @@ class MultimaterialStage {
     // (ALGORITHM §4.3): 1e-6 of the lightest particle, well above round-off.
     cfg_.mass_threshold = min_particle_mass * Real(kSliverMassFraction);
     cfg_.dt = Real(dt);
+    // USF: pass A's momenta are the strain's velocities (docs/contact_validation.md §13).
+    usf_ = scene.simulation.scheme == Scheme::USF;
     if (const char* why = validate_multimaterial(grid, cfg_))
       throw InputError(scene.source_file + ": multimaterial setup: " + why);
   }
@@ -97,7 +102,9 @@ class MultimaterialStage {
     cfg_.dt = Real(dt);
     cfg_.limit_dt = Real(limit_dt);
     stats_.reset(fields_);
-    multimaterial_pass_a(grid, list_, cfg_, stats_, stick_flags_, own, &geometry_);
+    if (usf_) carry_held_pairs();
+    multimaterial_pass_a(grid, list_, cfg_, stats_, stick_flags_, own, &geometry_,
+                         usf_ ? held_last_step_.data() : nullptr);
   }
   // PassB::strain for MUSL's repeat of pass B on the re-extrapolated momenta:
   // it holds the pairs the first pass B held (kHeldInPassB) and leaves the
@@ -107,11 +114,38 @@ class MultimaterialStage {
     if (!enabled_) return;
     if (which == PassB::after_update) {
       multimaterial_pass_b(grid, list_, cfg_, stick_flags_, stats_, own, &geometry_);
+      if (usf_) {  // for the next step's pass A (carry_held_pairs)
+        last_list_ = list_;
+        last_flags_ = stick_flags_;
+      }
       return;
     }
     const auto kept = stats_.rigid_reaction;
     multimaterial_pass_b(grid, list_, cfg_, stick_flags_, stats_, own, &geometry_, PassB::strain);
     stats_.rigid_reaction = kept;
+  }
+
+  // USF's record of the last pass B (carry_held_pairs) goes into checkpoints:
+  // without it the first step after a restart decided pass A on approach
+  // alone, and the run was no longer the uninterrupted one bit for bit.
+  void save_state(std::vector<io::Blob>& out) const {
+    if (!enabled_ || !usf_) return;
+    out.push_back(io::make_blob("mm.held_nodes", last_list_));
+    out.push_back(io::make_blob("mm.held_flags", last_flags_));
+  }
+  void load_state(const std::vector<io::Blob>& blobs) {
+    if (!enabled_ || !usf_) return;
+    last_list_.clear();
+    last_flags_.clear();
+    const io::Blob* nodes = io::find_optional_blob(blobs, "mm.held_nodes");
+    const io::Blob* flags = io::find_optional_blob(blobs, "mm.held_flags");
+    if (!nodes || !flags) return;  // an older checkpoint: the first pass A decides on approach
+    io::read_blob(*nodes, last_list_);
+    io::read_blob(*flags, last_flags_);
+    if (last_flags_.size() != last_list_.size() * std::size_t(fields_) ||
+        !std::is_sorted(last_list_.begin(), last_list_.end()))
+      throw std::runtime_error(
+          "checkpoint does not match the scene: mm.held_nodes / mm.held_flags");
   }
 
   StepCounters counters() const {
@@ -130,7 +164,22 @@ class MultimaterialStage {
   }
 
  private:
-  bool enabled_ = false, has_interface_ = false;
+  // USF: the kHeldInPassB and kStuckInPassB bits of the last step's pass B for
+  // this step's list (both lists ascend), zero where the node was not in the last one.
+  void carry_held_pairs() {
+    const std::size_t F = std::size_t(fields_);
+    held_last_step_.assign(list_.size() * F, 0);
+    std::size_t j = 0;
+    for (std::size_t k = 0; k < list_.size(); ++k) {
+      while (j < last_list_.size() && last_list_[j] < list_[k]) ++j;
+      if (j == last_list_.size()) break;
+      if (last_list_[j] != list_[k]) continue;
+      for (std::size_t f = 0; f < F; ++f)
+        held_last_step_[k * F + f] = last_flags_[j * F + f] & (kHeldInPassB | kStuckInPassB);
+    }
+  }
+
+  bool enabled_ = false, has_interface_ = false, usf_ = false;
   int fields_ = 1;
   std::vector<int> pair_;
   std::vector<unsigned char> rigid_;
@@ -140,6 +189,9 @@ class MultimaterialStage {
   std::vector<std::uint32_t> list_;
   std::vector<unsigned char> stick_flags_;
   PassAGeometry<D, Real> geometry_;  // pass A's, for pass B
+  // USF only (carry_held_pairs).
+  std::vector<std::uint32_t> last_list_;
+  std::vector<unsigned char> last_flags_, held_last_step_;
 };
 
 }  // namespace mmpm

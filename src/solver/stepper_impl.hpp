@@ -1624,6 +1624,7 @@ std::vector<io::Blob> Stepper<D, Shape, Real>::save_state() const {
   out.push_back(io::make_scalar_blob("damping_loss", damping_loss_));
   out.push_back(io::make_scalar_blob("dirty", int(dirty_)));
   out.push_back(io::make_scalar_blob("interface_energy", mm_.interface_energy()));
+  mm_.save_state(out);
   return out;
 }
 
@@ -1653,6 +1654,7 @@ void Stepper<D, Shape, Real>::load_state(const std::vector<io::Blob>& blobs) {
   grid_ready_ = false;  // the grid is not in the checkpoint: the next step scatters it again
   grid_ke_from_tail_ = false;
   mm_.set_interface_energy(io::read_scalar_blob<double>(io::find_blob(blobs, "interface_energy")));
+  mm_.load_state(blobs);
   rebuild_ranges();
 }
 
