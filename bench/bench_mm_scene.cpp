@@ -4,7 +4,9 @@
 // each iteration (untimed), and the solver's own MultimaterialStage (the
 // scene's laws, normals, thresholds and node ownership) does what a step
 // does: find the nodes, pass A, and pass B once per transfer (twice under
-// MUSL, the default scheme).
+// MUSL, the default scheme). The USL and USF variants of the interface scene
+// share one pass B per step, so their difference is USF's carried record of
+// held pairs (MultimaterialStage::carry_held_pairs, docs/contact_validation.md §13).
 #include <chrono>
 #include <cstring>
 
@@ -21,10 +23,16 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-void bm_mm_scene(benchmark::State& state, const std::string& scene, int threads) {
+// scheme: "" runs the scene as it is (shared with bench_step.cpp), else a new
+// Simulation of the scene under that scheme.
+void bm_mm_scene(benchmark::State& state, const std::string& scene, int threads,
+                 const std::string& scheme) {
   use_threads(threads);
   try {
-    Simulation& sim = step_scene_simulation(scene);
+    std::unique_ptr<Simulation> own_sim;
+    if (!scheme.empty())
+      own_sim = new_step_scene_simulation(scene, {"simulation.scheme=\"" + scheme + "\""});
+    Simulation& sim = own_sim ? *own_sim : step_scene_simulation(scene);
     auto* stepper = dynamic_cast<Stepper<2, GimpShape, double>*>(&sim);
     if (!stepper) {
       state.SkipWithError("the scene is not a 2D gimp double Stepper");
@@ -42,7 +50,8 @@ void bm_mm_scene(benchmark::State& state, const std::string& scene, int threads)
     for (int d = 0; d < 2; ++d) saved.emplace_back(G.p[d], G.p[d] + total);
     for (int d = 0; d < 2; ++d) saved.emplace_back(G.fi[d], G.fi[d] + total);
     // Pass B after each transfer: twice under MUSL (the default scheme), once otherwise.
-    const int passes_b = step_scene_scheme(scene) == Scheme::MUSL ? 2 : 1;
+    const bool musl = scheme.empty() ? step_scene_scheme(scene) == Scheme::MUSL : scheme == "MUSL";
+    const int passes_b = musl ? 2 : 1;
 
     double t_find = 0, t_a = 0, t_b = 0;
     for (auto _ : state) {
@@ -98,10 +107,18 @@ void register_mm_scene() {
       const std::string name =
           std::string("mm_scene/scene:") + scene + "/threads:" + std::to_string(threads);
       auto* b = benchmark::RegisterBenchmark(name.c_str(), [scene, threads](benchmark::State& st) {
-        bm_mm_scene(st, scene, threads);
+        bm_mm_scene(st, scene, threads, "");
       });
       configure(b->UseManualTime()->Unit(benchmark::kMicrosecond), 0.1);
     }
+  }
+  // USL against USF, one thread, adjacent in the run.
+  for (const char* scheme : {"USL", "USF"}) {
+    const std::string name = std::string("mm_scene/scene:2d_gimp_interface/scheme:") + scheme;
+    auto* b = benchmark::RegisterBenchmark(name.c_str(), [scheme](benchmark::State& st) {
+      bm_mm_scene(st, "2d_gimp_interface", 1, scheme);
+    });
+    configure(b->UseManualTime()->Unit(benchmark::kMicrosecond), 0.1);
   }
 }
 

@@ -1051,6 +1051,57 @@ TEST(ValidationContact, StiffPlatenUnderUsfReadsTheSeriesStiffness) {
   EXPECT_NEAR(coulomb[0] / coulomb[1], 1.0, 0.01);
 }
 
+// §14 The stiff platen with quadratic B-splines: the reaction's mean over
+// 0.1-0.3 ms against the series stiffness, minus 1, at h = 0.25 mm (L/h = 16)
+// and 0.125 mm (32), with the interaction's normal given by `normal`.
+std::array<double, 2> stiff_platen_excess_with_bspline2(const std::vector<std::string>& normal) {
+  std::array<double, 2> excess{};
+  const char* cells[2][2] = {{"grid.cell=[0.25, 0.25]", "grid.cells=[28, 28]"},
+                             {"grid.cell=[0.125, 0.125]", "grid.cells=[56, 56]"}};
+  for (int r = 0; r < 2; ++r) {
+    std::vector<std::string> overrides = {"grid.shape=\"bspline2\"", cells[r][0], cells[r][1]};
+    overrides.insert(overrides.end(), normal.begin(), normal.end());
+    auto sim = stiff_platen_for_0_3ms(overrides);
+    excess[r] =
+        reaction_over_exact(*sim, "plane_y=4.5", {0.1, 0.3}, stiff_platen_stiffness(), 0.01)[0] -
+        1.0;
+  }
+  return excess;
+}
+
+// With the specified normal (0, 1) the splines' excess is the width of their
+// contact layer (three node rows hold both materials): it halves with h.
+// Measured +2.12 % and +1.10 % (+0.58 % at h = 0.0625, 0.05 ms means). The
+// tolerances: the fine excess 0.4-0.65 of the coarse one (first order), and
+// under 1.5 %. 14 s.
+TEST(ValidationContact, StiffPlatenWithSplinesConvergesUnderTheSpecifiedNormal) {
+  const std::array<double, 2> e = stiff_platen_excess_with_bspline2(
+      {"interaction[0].normal=\"specified\"", "interaction[0].normal_vector=[0.0, 1.0]"});
+  note("stiff platen, bspline2, specified normal: F / k - 1 = %.4f at h = 0.25, %.4f at 0.125",
+       e[0], e[1]);
+  EXPECT_GT(e[1], 0.4 * e[0]);
+  EXPECT_LT(e[1], 0.65 * e[0]);
+  EXPECT_LT(std::abs(e[1]), 0.015);
+}
+
+// The same under the default mass-gradient normal. The block's free top
+// corner tilts it (n = (0.705, 0.710) and (0.996, 0.085) on the nodes there),
+// so the platen's push holds the corner from spreading: a point restraint
+// whose effect barely shrinks with h (+3.4 % and +3.3 %; +2.7 % at
+// h = 0.0625). Same tolerances as the specified normal's test.
+TEST(ValidationContact, StiffPlatenWithSplinesConvergesUnderTheMassGradientNormal) {
+  MMPM_KNOWN_LIMITATION(
+      "with bspline2 the MVG normal tilts at the block's free corner and restrains it: "
+      "+3.4 % and +3.3 % at h = 0.25 and 0.125 mm, where the specified normal halves "
+      "(docs/contact_validation.md §14)");
+  const std::array<double, 2> e = stiff_platen_excess_with_bspline2({});
+  note("stiff platen, bspline2, MVG normal: F / k - 1 = %.4f at h = 0.25, %.4f at 0.125", e[0],
+       e[1]);
+  EXPECT_GT(e[1], 0.4 * e[0]);
+  EXPECT_LT(e[1], 0.65 * e[0]);
+  EXPECT_LT(std::abs(e[1]), 0.015);
+}
+
 // USF's carried record (the last pass B's held and stuck pairs) is state
 // between steps, so it is in the checkpoint: a run restored part-way
 // continues as the uninterrupted one, bit for bit. Restored without it (a
