@@ -159,6 +159,9 @@ inline constexpr unsigned char kHeldInPassB = 16;
 // stuck (a platen pressed through mu = 0.3 read 1.003-1.010 of the stiffness it has
 // stuck, 1.051; docs/contact_validation.md §13).
 inline constexpr unsigned char kStuckInPassB = 32;
+// The bits pass B leaves for the next step (USF's pass A reads them,
+// MultimaterialStage::carry_held_pairs carries them).
+inline constexpr unsigned char kPassBRecord = kHeldInPassB | kStuckInPassB;
 // Whether pass B holds this pair regardless of approach: only in MUSL's strain pass,
 // and only where the pass B before it held the pair.
 inline bool held_before(unsigned char stick, bool strain_pass) {

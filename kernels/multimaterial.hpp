@@ -590,7 +590,7 @@ inline void record_held(unsigned char* flags_out, std::size_t slot, bool held, b
   if (!flags_out) return;
   const unsigned char bits =
       (unsigned char)((held ? kHeldInPassB : 0) | (held && stuck ? kStuckInPassB : 0));
-  flags_out[slot] = (unsigned char)((flags_out[slot] & ~(kHeldInPassB | kStuckInPassB)) | bits);
+  flags_out[slot] = (unsigned char)((flags_out[slot] & ~kPassBRecord) | bits);
 }
 
 // One node of the list, pass A (kPassA) or pass B. Pass B records in flags_out

@@ -75,8 +75,7 @@ Outcome run(TestGrid<D, Real>& grid, TestSetup<D, Real>& setup, bool batch,
   // USF's next step on the same nodes: pass A holds the pairs the last pass B
   // held (and sticks the Coulomb pairs it held stuck), from the momenta as they are.
   std::vector<unsigned char> held(out.flags.size());
-  for (std::size_t k = 0; k < held.size(); ++k)
-    held[k] = out.flags[k] & (mmpm::kHeldInPassB | mmpm::kStuckInPassB);
+  for (std::size_t k = 0; k < held.size(); ++k) held[k] = out.flags[k] & mmpm::kPassBRecord;
   mmpm::multimaterial_pass_a(grid.view, list, cfg, out.stats, out.flags, {}, &geometry,
                              held.data());
   out.limited_total = out.stats.force_limited;  // both passes A

@@ -175,7 +175,7 @@ class MultimaterialStage {
       if (j == last_list_.size()) break;
       if (last_list_[j] != list_[k]) continue;
       for (std::size_t f = 0; f < F; ++f)
-        held_last_step_[k * F + f] = last_flags_[j * F + f] & (kHeldInPassB | kStuckInPassB);
+        held_last_step_[k * F + f] = last_flags_[j * F + f] & kPassBRecord;
     }
   }
 
