@@ -37,6 +37,20 @@ inline constexpr double kSliverMassFraction = 1e-6;
 // B-spline stencils do not use this one (MultimaterialStage::setup says why).
 inline constexpr double kRigidPresentFraction = 0.05;
 
+// Either material of a deformable contact pair whose nodal domain fills less
+// than this fraction of a cell is taken as absent at the node, under the same
+// separations and stencils as kRigidPresentFraction. A uGIMP particle's domain
+// reaches the next node row as soon as it moves: a pressed face that travels
+// e past a grid line puts a sliver of about e^2 / (2 h^2) of a cell on the row
+// beyond it (0.3 % at e = 0.08 h), and the partner's load then entered one row
+// too deep: a stiff platen on a block stiffened by 1.7 % over 0.08 h of travel
+// (docs/contact_validation.md §14). Smaller than the rigid fraction because
+// here both partners' slivers are screened: at 0.05 two blocks meeting at a
+// third of a cell past a grid line (linear shapes) exchanged their velocities
+// with a 7.7 % error instead of 1.5 %; 0.01-0.03 gave the same impacts within
+// 1 % of each other (§15).
+inline constexpr double kContactPresentFraction = 0.02;
+
 // Properties of one interacting material pair (one [[interaction]] of the scene).
 template <class Real>
 struct PairParams {
@@ -67,6 +81,10 @@ struct PairParams {
   // ABSOLUTE nodal domain of a rigid partner below which it is absent at the
   // node (units of grid.vol; kRigidPresentFraction of a cell, 0 = no test).
   Real rigid_min_volume = 0;
+  // ABSOLUTE nodal domain below which either material of a deformable contact
+  // pair is absent at the node (units of grid.vol; kContactPresentFraction of
+  // a cell, 0 = no test).
+  Real presence_min_volume = 0;
   bool force_limit = true;  // §4.4 (explicit integration only)
   Integration integration = Integration::explicit_;
   // The (P-20) area on domains with the opening closed (interface law only,

@@ -254,6 +254,7 @@ template <NormalMethod M, Law L, bool UseDf, bool Closed, int D, class Real>
                                    Real dt, Real thickness) {
   const PairParams<Real>& pp = *B.params;
   const Real omega_min = pp.omega_min, friction = pp.friction;
+  const Real presence = pp.presence_min_volume;  // 0 for an interface (kContactPresentFraction)
   const bool position_method = pp.separation == Separation::position;
   const Real contact_offset = pp.contact_offset;
   const bool bilinear = pp.traction_law == TractionLaw::bilinear;
@@ -289,7 +290,7 @@ template <NormalMethod M, Law L, bool UseDf, bool Closed, int D, class Real>
     }
     // & and | rather than && and || on lane conditions: short-circuits are
     // branches, which keep a loop from being if-converted and vectorised.
-    const bool screened = va + vb < omega_min;
+    const bool screened = (va + vb < omega_min) | (va < presence) | (vb < presence);
     const bool valid = !screened & finite_nonzero<D, Real>(n);
 
     // (P-7, P-8), (P-11), (P-12), (P-15), (P-22), (P-14).

@@ -353,8 +353,9 @@ DirectionOutcome<Real> interface_direction(const PairParams<Real>& pp, bool perf
   return o;
 }
 
-// Volume screening (§3), a rigid partner's presence (kRigidPresentFraction), then the
-// pair geometry; G.valid is false when the pair is skipped.
+// Volume screening (§3), a rigid partner's presence (kRigidPresentFraction) or
+// both deformable partners' (kContactPresentFraction), then the pair geometry;
+// G.valid is false when the pair is skipped.
 template <int D, class Real>
 PairGeometry<D, Real> screened_geometry(const MaterialSide<D, Real>& a,
                                         const MaterialSide<D, Real>& b, bool b_is_rigid,
@@ -363,6 +364,8 @@ PairGeometry<D, Real> screened_geometry(const MaterialSide<D, Real>& a,
                                         const std::array<Real, 3>& h) {
   if (a.vol + b.vol < pp.omega_min) return PairGeometry<D, Real>{};
   if (b_is_rigid && b.vol < pp.rigid_min_volume) return PairGeometry<D, Real>{};
+  if (!b_is_rigid && (a.vol < pp.presence_min_volume || b.vol < pp.presence_min_volume))
+    return PairGeometry<D, Real>{};
   return pair_geometry<D, Real>(a, b, b_is_rigid, pp, sign, node_position, h);
 }
 

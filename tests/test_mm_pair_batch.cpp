@@ -163,6 +163,8 @@ void check_two_fields() {
         pp.separation = variant & 1 ? Separation::position : Separation::displacement;
         pp.contact_offset = Real(0.65);  // not the default: the batch must read it
         pp.omega_min = variant & 2 ? Real(0.4) : Real(0);  // screens some nodes
+        // A sliver of either partner is absent (kContactPresentFraction): contact laws only.
+        if (law != Law::interface && (variant & 2)) pp.presence_min_volume = Real(0.2);
         pp.force_limit = (variant & 4) == 0;
         pp.traction_law = variant & 8 ? TractionLaw::bilinear : TractionLaw::linear;
         // A perfect compression branch (one-sided, docs/multimaterial.md §4.1) in half

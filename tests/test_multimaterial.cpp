@@ -241,6 +241,30 @@ TEST(MultimaterialContact, VolumeScreeningSkipsSmallNodes) {
   }
 }
 
+// A deformable contact partner below presence_min_volume is absent at the
+// node (kContactPresentFraction): with either field's domain 0.02 under the
+// threshold the pair is skipped; at or above it the stick holds (the centre-of-
+// mass velocity, -0.2). Per node and batched.
+TEST(MultimaterialContact, PresenceSkipsASliverOfEitherPartner) {
+  for (const bool batch : {false, true})
+    for (const int sliver : {0, 1})
+      for (const double domain : {0.28, 0.3}) {  // threshold 0.3
+        TwoBodyNode t;
+        const std::size_t i = t.grid.at(sliver, 0);
+        t.grid.vol[i] = domain;
+        auto pp = contact_params<double>(Law::stick);
+        pp.presence_min_volume = 0.3;
+        t.setup.connect(0, 1, pp);
+        t.setup.cfg.batch_pairs = batch;
+        MMStats stats;
+        std::vector<unsigned char> flags;
+        run_pass_a(t.grid, t.setup, stats, flags);
+        for (int j = 0; j < 2; ++j)
+          EXPECT_NEAR(t.grid.velocity(j, 0, 0), domain < 0.3 ? (j == 0 ? 1.0 : -1.0) : -0.2, kTol)
+              << "batch " << batch << " sliver field " << sliver << " domain " << domain;
+      }
+}
+
 TEST(MultimaterialContact, SeparatePairAndEmptyFieldDoNothing) {
   TwoBodyNode t;  // no connect(): pair table entry -1
   MMStats stats;

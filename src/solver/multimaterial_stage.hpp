@@ -59,6 +59,11 @@ class MultimaterialStage {
           scene.grid.shape == ShapeKind::linear || scene.grid.shape == ShapeKind::gimp;
       if (it.separation != Separation::position && cell_stencil)
         pp.rigid_min_volume = Real(kRigidPresentFraction * cell);
+      // Both partners' presence for the contact laws (kContactPresentFraction),
+      // same stencils and separations; not for an interface, which is bonded
+      // at every node both materials share.
+      if (it.separation != Separation::position && cell_stencil && it.law != Law::interface)
+        pp.presence_min_volume = Real(kContactPresentFraction * cell);
       pp.force_limit = it.force_limit;
       pp.integration = it.integration;
       pp.closed_area = it.law == Law::interface && it.area == ContactArea::closed;
