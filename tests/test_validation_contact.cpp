@@ -1128,24 +1128,13 @@ TEST(ValidationContact, StiffPlatenWithSplinesConvergesUnderTheMassGradientNorma
   EXPECT_LT(std::abs(e[1]), 0.015);
 }
 
-// §14-15 uGIMP pressed contact over the scene's whole 1 ms drive (0.01 mm,
-// 4 % of a cell at h = 0.25, 8 % at 0.125). The platen's particle domains,
-// flush with the face on a grid line, reach the node row below as soon as
-// they move; that row turned multimaterial with a sliver of platen and the
-// reaction rose with the travel: 1.000 -> 1.009 at h = 0.25 and 1.001 ->
-// 1.017 at h = 0.125 (0.1 ms means). A contact partner under
-// kContactPresentFraction of a cell is now absent at the node. Measured
-// 2026-12-05 (0.1 ms means at 0.1-0.2 / 0.9-1.0 ms): 0.9991 / 0.9979 and
-// 0.9996 / 0.9982 (h = 0.125: the long twin below). Tolerances: each mean within 0.5 % of k, and the last
-// within 0.3 % of the first (before: 0.9 % and 1.6 %). cfl 0.4 at h = 0.125:
-// with 0.5 the first 0.25 ms ring by +-4.5 % there (§14, not this effect).
 // The stiff platen with uGIMP at cell h over the whole 1 ms drive: the reaction's
 // 0.1 ms means over 0.1-0.2 and 0.9-1.0 ms, against k.
 std::array<double, 2> stiff_platen_with_ugimp_over_1ms(double h) {
   std::vector<std::string> overrides{"grid.shape=\"gimp\""};
   if (h < 0.2)
-    overrides.insert(overrides.end(), {"grid.cell=[0.125, 0.125]", "grid.cells=[56, 56]",
-                                       "simulation.cfl=0.4"});
+    overrides.insert(overrides.end(),
+                     {"grid.cell=[0.125, 0.125]", "grid.cells=[56, 56]", "simulation.cfl=0.4"});
   auto sim = make_simulation(parse_scene_file(input("stiff_platen.toml"), overrides));
   const std::vector<double> ratio = reaction_over_exact(*sim, "plane_y=4.5", {0.1, 0.2, 0.9, 1.0},
                                                         stiff_platen_stiffness(), 0.01);
@@ -1157,6 +1146,18 @@ std::array<double, 2> stiff_platen_with_ugimp_over_1ms(double h) {
   return {ratio[0], ratio[2]};
 }
 
+// §14-15 uGIMP pressed contact over the scene's whole 1 ms drive (0.01 mm,
+// 4 % of a cell at h = 0.25, 8 % at 0.125). The platen's particle domains,
+// flush with the face on a grid line, reach the node row below as soon as
+// they move; that row turned multimaterial with a sliver of platen and the
+// reaction rose with the travel: 1.000 -> 1.009 at h = 0.25 and 1.001 ->
+// 1.017 at h = 0.125 (0.1 ms means). A contact partner under
+// kContactPresentFraction of a cell is now absent at the node. Measured
+// 2026-12-05 (0.1 ms means at 0.1-0.2 / 0.9-1.0 ms): 0.9991 / 0.9979 and
+// 0.9996 / 0.9982 (h = 0.125: the long twin below). Tolerances: each mean
+// within 0.5 % of k, and the last within 0.3 % of the first (before: 0.9 %
+// and 1.6 %). cfl 0.4 at h = 0.125: with 0.5 the first 0.25 ms ring by
+// +-4.5 % there (§14, not this effect).
 TEST(ValidationContact, StiffPlatenWithUgimpHoldsItsStiffnessAsTheFacesTravel) {
   stiff_platen_with_ugimp_over_1ms(0.25);
 }
