@@ -1133,8 +1133,7 @@ TEST(ValidationContact, StiffPlatenWithSplinesConvergesUnderTheMassGradientNorma
 std::array<double, 2> stiff_platen_with_ugimp_over_1ms(double h) {
   std::vector<std::string> overrides{"grid.shape=\"gimp\""};
   if (h < 0.2)
-    overrides.insert(overrides.end(),
-                     {"grid.cell=[0.125, 0.125]", "grid.cells=[56, 56]", "simulation.cfl=0.4"});
+    overrides.insert(overrides.end(), {"grid.cell=[0.125, 0.125]", "grid.cells=[56, 56]"});
   auto sim = make_simulation(parse_scene_file(input("stiff_platen.toml"), overrides));
   const std::vector<double> ratio = reaction_over_exact(*sim, "plane_y=4.5", {0.1, 0.2, 0.9, 1.0},
                                                         stiff_platen_stiffness(), 0.01);
@@ -1154,10 +1153,9 @@ std::array<double, 2> stiff_platen_with_ugimp_over_1ms(double h) {
 // 1.017 at h = 0.125 (0.1 ms means). A contact partner under
 // kContactPresentFraction of a cell is now absent at the node. Measured
 // 2026-12-05 (0.1 ms means at 0.1-0.2 / 0.9-1.0 ms): 0.9991 / 0.9979 and
-// 0.9996 / 0.9982 (h = 0.125: the long twin below). Tolerances: each mean
+// 0.9995 / 0.9982 (h = 0.125: the long twin below). Tolerances: each mean
 // within 0.5 % of k, and the last within 0.3 % of the first (before: 0.9 %
-// and 1.6 %). cfl 0.4 at h = 0.125: with 0.5 the first 0.25 ms ring by
-// +-4.5 % there (§14, not this effect).
+// and 1.6 %).
 TEST(ValidationContact, StiffPlatenWithUgimpHoldsItsStiffnessAsTheFacesTravel) {
   stiff_platen_with_ugimp_over_1ms(0.25);
 }
@@ -1241,8 +1239,8 @@ TEST(ValidationContactLong, HeadOnImpactRefined) {
 // Disk at h = 0.25 and 0.125 mm (12 and 24 cells per radius): rolling a
 // within 10 % and the rolling constraint within 5 %; sliding a within 5 % and
 // its spin-up within 10 %. Runs 6 s (h = 0.125 mm: 7000 disk particles).
-// The same at h = 0.125 (cfl 0.4), twice the travel in cells (8 %): before
-// the presence rule 1.001 -> 1.017; measured 0.9996 / 0.9982 (2026-12-05).
+// The same at h = 0.125, twice the travel in cells (8 %): before
+// the presence rule 1.001 -> 1.017; measured 0.9995 / 0.9982 (2026-12-05).
 TEST(ValidationContactLong, StiffPlatenWithUgimpHoldsItsStiffnessRefined) {
   MMPM_LONG_TEST();
   stiff_platen_with_ugimp_over_1ms(0.125);
