@@ -37,9 +37,10 @@ inline constexpr double kSliverMassFraction = 1e-6;
 // B-spline stencils do not use this one (MultimaterialStage::setup says why).
 inline constexpr double kRigidPresentFraction = 0.05;
 
-// Either material of a deformable contact pair whose nodal domain fills less
-// than this fraction of a cell is taken as absent at the node, under the same
-// separations and stencils as kRigidPresentFraction. A uGIMP particle's domain
+// Either material of a deformable frictionless pair whose nodal domain fills
+// less than this fraction of a cell is taken as absent at the node, under the
+// same separations and stencils as kRigidPresentFraction (MultimaterialStage
+// says why not under stick and Coulomb). A uGIMP particle's domain
 // reaches the next node row as soon as it moves: a pressed face that travels
 // e past a grid line puts a sliver of about e^2 / (2 h^2) of a cell on the row
 // beyond it (0.3 % at e = 0.08 h), and the partner's load then entered one row

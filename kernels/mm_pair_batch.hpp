@@ -254,7 +254,7 @@ template <NormalMethod M, Law L, bool UseDf, bool Closed, int D, class Real>
                                    Real dt, Real thickness) {
   const PairParams<Real>& pp = *B.params;
   const Real omega_min = pp.omega_min, friction = pp.friction;
-  const Real presence = pp.presence_min_volume;  // 0 for an interface (kContactPresentFraction)
+  const Real presence = pp.presence_min_volume;  // kContactPresentFraction or 0
   const bool position_method = pp.separation == Separation::position;
   const Real contact_offset = pp.contact_offset;
   const bool bilinear = pp.traction_law == TractionLaw::bilinear;
