@@ -1273,80 +1273,16 @@ TEST(ValidationContactLong, StiffPlatenWithUgimpHoldsItsStiffnessRefined) {
   stiff_platen_with_ugimp_over_1ms(0.125);
 }
 
-// The same in 3D: a quarter model (symmetry planes x = 0 and y = 0, free
-// sides at x = y = 2), block 2 x 2 x 4 mm, platen 3 x 3 x 0.5 mm, uGIMP,
-// h = 0.25, 2 ppc, the top nodes driven 0.01 mm over 1 ms. k = E A / L in
-// series with the platen (A = 4 mm^2): 998.75 N/mm. Before the presence rule
+// The same in 3D (inputs/stiff_platen_3d.toml): a quarter model (symmetry
+// planes x = 0 and y = 0, free sides at x = y = 2), block 2 x 2 x 4 mm, platen
+// 3 x 3 x 0.5 mm, uGIMP, h = 0.25, 2 ppc, the top nodes driven 0.01 mm over
+// 1 ms. k = E A / L in series with the platen (A = 4 mm^2): 998.75 N/mm. Before the presence rule
 // the 0.1 ms means rose 1.0005 -> 1.0063 (series rows, every 7 steps);
 // measured with it 2026-12-05 (step means): 0.9995 / 0.9986. Same
 // tolerances as 2D. 80000 steps, about 100 s on 2 threads.
 TEST(ValidationContactLong, StiffPlatenWithUgimpHoldsItsStiffness3D) {
   MMPM_LONG_TEST();
-  const std::string scene = R"(
-[simulation]
-dimension = 3
-end_time  = 1.0
-cfl       = 0.5
-
-[grid]
-origin = [-1.0, -1.0, -1.0]
-cell   = [0.25, 0.25, 0.25]
-cells  = [16, 16, 28]
-shape  = "gimp"
-
-[[material]]
-name    = "block"
-type    = "isotropic"
-density = 1.0e-3
-E       = 1000.0
-nu      = 0.3
-
-[[material]]
-name    = "platen"
-type    = "isotropic"
-density = 1.0e-3
-E       = 100000.0
-nu      = 0.0
-
-[[body]]
-name     = "block"
-material = "block"
-shape    = "box"
-min      = [0.0, 0.0, 0.0]
-max      = [2.0, 2.0, 4.0]
-particles_per_cell = 2
-
-[[body]]
-name     = "platen"
-material = "platen"
-shape    = "box"
-min      = [-0.5, -0.5, 4.0]
-max      = [2.5, 2.5, 4.5]
-particles_per_cell = 2
-
-[[interaction]]
-materials = ["block", "platen"]
-law       = "frictionless"
-
-[[boundary]]
-where = { min = [-1.0, -1.0, -1.0], max = [3.0, 3.0, 0.0] }
-fix   = ["z"]
-
-[[boundary]]
-where = { min = [-1.0, -1.0, -1.0], max = [0.0, 3.0, 6.0] }
-fix   = ["x"]
-
-[[boundary]]
-where = { min = [-1.0, -1.0, -1.0], max = [3.0, 0.0, 6.0] }
-fix   = ["y"]
-
-[[boundary]]
-where        = { z = 4.5 }
-fix          = ["z"]
-displacement = [0.0, 0.0, -0.01]
-ramp         = 1.0
-)";
-  auto sim = testing::make_from_text(scene);
+  auto sim = make_simulation(parse_scene_file(input("stiff_platen_3d.toml")));
   const double k = 1.0 / (4.0 / (1000.0 * 4.0) + 0.5 / (1.0e5 * 4.0));
   const std::vector<double> ratio =
       reaction_over_exact(*sim, "plane_z=4.5", {0.1, 0.2, 0.9, 1.0}, k, 0.01, 2);
