@@ -55,16 +55,16 @@ class MultimaterialStage {
       // from the first step, so there the displacement method's premise
       // (both materials at the node from the start) holds; with the test the
       // platen read further from exact, not nearer (docs/contact_validation.md §11).
-      const bool cell_stencil =
-          scene.grid.shape == ShapeKind::linear || scene.grid.shape == ShapeKind::gimp;
-      if (it.separation != Separation::position && cell_stencil)
-        pp.rigid_min_volume = Real(kRigidPresentFraction * cell);
+      const bool presence_tested =
+          it.separation != Separation::position &&
+          (scene.grid.shape == ShapeKind::linear || scene.grid.shape == ShapeKind::gimp);
+      if (presence_tested) pp.rigid_min_volume = Real(kRigidPresentFraction * cell);
       // Both partners' presence for frictionless contact (kContactPresentFraction),
       // same stencils and separations. Not for stick or Coulomb: with it a
       // uGIMP block's free corner under a stiff platen rang (Coulomb gained
       // 10 % of the work over a 20 ms hold); not for an interface, which is
       // bonded at every node both materials share (docs/contact_validation.md §15).
-      if (it.separation != Separation::position && cell_stencil && it.law == Law::frictionless)
+      if (presence_tested && it.law == Law::frictionless)
         pp.presence_min_volume = Real(kContactPresentFraction * cell);
       pp.force_limit = it.force_limit;
       pp.integration = it.integration;
