@@ -39,12 +39,14 @@ inline constexpr double kRigidPresentFraction = 0.05;
 
 // Either material of a deformable frictionless pair whose nodal domain fills
 // less than this fraction of a cell is taken as absent at the node, under the
-// same separations and stencils as kRigidPresentFraction (MultimaterialStage
-// says why not under stick and Coulomb). A uGIMP particle's domain
-// reaches the next node row as soon as it moves: a pressed face that travels
-// e past a grid line puts a sliver of about e^2 / (2 h^2) of a cell on the row
-// beyond it (0.3 % at e = 0.08 h), and the partner's load then entered one row
-// too deep: a stiff platen on a block stiffened by 1.7 % over 0.08 h of travel
+// same separations and stencils as kRigidPresentFraction; under stick, only a
+// sliver thin along the normal that faces a present partner
+// (PairParams::presence_thin_along_normal); not under Coulomb
+// (MultimaterialStage says why). A uGIMP particle's domain reaches the next
+// node row as soon as it moves: a pressed face that travels e past a grid
+// line puts a sliver of about e^2 / (2 h^2) of a cell on the row beyond it
+// (0.3 % at e = 0.08 h), and the partner's load then entered one row too
+// deep: a stiff platen on a block stiffened by 1.7 % over 0.08 h of travel
 // (docs/contact_validation.md §14). Smaller than the rigid fraction because
 // here both partners' slivers are screened: at 0.05 two blocks meeting at a
 // third of a cell past a grid line (linear shapes) exchanged their velocities
@@ -86,6 +88,9 @@ struct PairParams {
   // pair is absent at the node (units of grid.vol; kContactPresentFraction of
   // a cell, 0 = no test).
   Real presence_min_volume = 0;
+  // The presence test absents only a sliver thin along the normal whose
+  // partner is present (mm_detail::partner_absent); needs g (P-33).
+  bool presence_thin_along_normal = false;
   bool force_limit = true;  // §4.4 (explicit integration only)
   Integration integration = Integration::explicit_;
   // The (P-20) area on domains with the opening closed (interface law only,
@@ -229,6 +234,35 @@ inline VecD<D, Real> normalized_or_zero(const VecD<D, Real>& u) {
   const Real len = std::sqrt(dot<D, Real>(u, u));
   if (!(len > 0) || !std::isfinite(len)) return VecD<D, Real>{};
   return scaled<D, Real>(u, Real(1) / len);
+}
+
+// Whether a material's nodal domain is thin along n: its gradient g (P-33)
+// lies within 45 degrees of the normal. A sliver beyond a face pressed
+// across a grid line is thin along the normal; one beside a free edge that
+// bulges past a grid line in the contact row is thin across it (zero g: not
+// along n).
+template <int D, class Real>
+inline bool thin_along_normal(const VecD<D, Real>& g, const VecD<D, Real>& n) {
+  const Real gn = dot<D, Real>(g, n);
+  return Real(2) * gn * gn > dot<D, Real>(g, g);
+}
+
+// The presence test of a deformable pair (PairParams::presence_min_volume,
+// 0: none). Frictionless: either partner's sliver is absent. With
+// thin_along_only (PairParams::presence_thin_along_normal, stick): only a
+// sliver thin along n that faces a present partner, the kind that carried
+// the partner's load a row too deep (docs/contact_validation.md §15). A
+// sliver beside a free edge carries the corner's shear into the partner:
+// freed, its node drove the corner particle (§16). & and | keep the test
+// branch-free in the pair batch's lanes.
+template <int D, class Real>
+inline bool partner_absent(Real vol_a, Real vol_b, const VecD<D, Real>& g_a,
+                           const VecD<D, Real>& g_b, const VecD<D, Real>& n, Real presence,
+                           bool thin_along_only) {
+  const bool sliver_a = vol_a < presence, sliver_b = vol_b < presence;
+  const bool along = (sliver_a & !sliver_b & thin_along_normal<D, Real>(g_a, n)) |
+                     (sliver_b & !sliver_a & thin_along_normal<D, Real>(g_b, n));
+  return ((!thin_along_only) & (sliver_a | sliver_b)) | (thin_along_only & along);
 }
 
 }  // namespace mm_detail

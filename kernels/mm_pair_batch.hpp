@@ -255,6 +255,7 @@ template <NormalMethod M, Law L, bool UseDf, bool Closed, int D, class Real>
   const PairParams<Real>& pp = *B.params;
   const Real omega_min = pp.omega_min, friction = pp.friction;
   const Real presence = pp.presence_min_volume;  // kContactPresentFraction or 0
+  const bool presence_thin_along_normal = pp.presence_thin_along_normal;
   const bool position_method = pp.separation == Separation::position;
   const Real contact_offset = pp.contact_offset;
   const bool bilinear = pp.traction_law == TractionLaw::bilinear;
@@ -266,10 +267,12 @@ template <NormalMethod M, Law L, bool UseDf, bool Closed, int D, class Real>
   for (int i = 0; i < count; ++i) {
     const Real ma = B.m[0][i], mb = B.m[1][i], va = B.vol[0][i], vb = B.vol[1][i];
     const VecD<D, Real> pa = lane<D, Real>(B.p[0][0], i), pb = lane<D, Real>(B.p[1][0], i);
-    // §5 normal a → b.
+    // §5 normal a → b. The domain gradients also serve stick's presence test.
+    constexpr bool kGradient = M != NormalMethod::specified && M != NormalMethod::radial;
+    VecD<D, Real> ga{}, gb{};
+    if constexpr (kGradient) ga = lane<D, Real>(B.g[0][0], i), gb = lane<D, Real>(B.g[1][0], i);
     VecD<D, Real> n;
     if constexpr (M == NormalMethod::avg) {
-      const VecD<D, Real> ga = lane<D, Real>(B.g[0][0], i), gb = lane<D, Real>(B.g[1][0], i);
       VecD<D, Real> u;
       for (int d = 0; d < D; ++d) u[d] = s_out * (va * ga[d] - vb * gb[d]);
       n = unit_or_zero<D, Real>(u);
@@ -282,7 +285,6 @@ template <NormalMethod M, Law L, bool UseDf, bool Closed, int D, class Real>
       n = unit_or_zero<D, Real>(
           radial_direction<D, Real>(x, pp.radial_center, pp.radial_axis, sign));
     } else {  // mvg (and rigid, which is mvg without a rigid partner)
-      const VecD<D, Real> ga = lane<D, Real>(B.g[0][0], i), gb = lane<D, Real>(B.g[1][0], i);
       const bool use_a = dot<D, Real>(ga, ga) >= dot<D, Real>(gb, gb);
       VecD<D, Real> u;
       for (int d = 0; d < D; ++d) u[d] = use_a ? ga[d] * s_out : gb[d] * -s_out;
@@ -290,7 +292,9 @@ template <NormalMethod M, Law L, bool UseDf, bool Closed, int D, class Real>
     }
     // & and | rather than && and || on lane conditions: short-circuits are
     // branches, which keep a loop from being if-converted and vectorised.
-    const bool screened = (va + vb < omega_min) | (va < presence) | (vb < presence);
+    const bool screened =
+        (va + vb < omega_min) |
+        partner_absent<D, Real>(va, vb, ga, gb, n, presence, presence_thin_along_normal);
     const bool valid = !screened & finite_nonzero<D, Real>(n);
 
     // (P-7, P-8), (P-11), (P-12), (P-15), (P-22), (P-14).

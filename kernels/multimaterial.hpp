@@ -120,6 +120,9 @@ const char* validate_multimaterial(const GridView<D, Real>& grid, const MMConfig
       if (!cfg.params) return "MMConfig.params is required by the pair table";
       const PairParams<Real>& pp = cfg.params[k];
       const bool gradient = reads_domain_gradient(pp);
+      if (pp.presence_thin_along_normal && pp.presence_min_volume > 0 && !gradient)
+        return "stick's presence test (a sliver thin along the normal) needs the mvg, avg or rigid "
+               "normal";
       for (int d = 0; d < D; ++d) {
         if (gradient && !grid.g[d])
           return "grid g is required by the mvg/avg/rigid normals and the closed area";
@@ -354,7 +357,8 @@ DirectionOutcome<Real> interface_direction(const PairParams<Real>& pp, bool perf
 }
 
 // Volume screening (§3), a rigid partner's presence (kRigidPresentFraction) or
-// both deformable partners' (kContactPresentFraction), then the pair geometry;
+// both deformable partners' (kContactPresentFraction, partner_absent: after the
+// geometry, which stick's test reads the normal of), then the pair geometry;
 // G.valid is false when the pair is skipped.
 template <int D, class Real>
 PairGeometry<D, Real> screened_geometry(const MaterialSide<D, Real>& a,
@@ -364,9 +368,14 @@ PairGeometry<D, Real> screened_geometry(const MaterialSide<D, Real>& a,
                                         const std::array<Real, 3>& h) {
   if (a.vol + b.vol < pp.omega_min) return PairGeometry<D, Real>{};
   if (b_is_rigid && b.vol < pp.rigid_min_volume) return PairGeometry<D, Real>{};
-  if (!b_is_rigid && (a.vol < pp.presence_min_volume || b.vol < pp.presence_min_volume))
+  const bool sliver = a.vol < pp.presence_min_volume || b.vol < pp.presence_min_volume;
+  const PairGeometry<D, Real> G =
+      pair_geometry<D, Real>(a, b, b_is_rigid, pp, sign, node_position, h);
+  if (!b_is_rigid && sliver && G.valid &&
+      partner_absent<D, Real>(a.vol, b.vol, a.g, b.g, G.n, pp.presence_min_volume,
+                              pp.presence_thin_along_normal))
     return PairGeometry<D, Real>{};
-  return pair_geometry<D, Real>(a, b, b_is_rigid, pp, sign, node_position, h);
+  return G;
 }
 
 // held_already: hold the pair whatever the approach; stuck_already (with it): a

@@ -165,6 +165,9 @@ void check_two_fields() {
         pp.omega_min = variant & 2 ? Real(0.4) : Real(0);  // screens some nodes
         // A sliver of either partner is absent (kContactPresentFraction): contact laws only.
         if (law != Law::interface && (variant & 2)) pp.presence_min_volume = Real(0.2);
+        // Stick's test, a sliver thin along the normal only: it reads g.
+        pp.presence_thin_along_normal =
+            law == Law::stick && mmpm::reads_domain_gradient(pp) && (variant & 1) != 0;
         pp.force_limit = (variant & 4) == 0;
         pp.traction_law = variant & 8 ? TractionLaw::bilinear : TractionLaw::linear;
         // A perfect compression branch (one-sided, docs/multimaterial.md §4.1) in half

@@ -265,6 +265,50 @@ TEST(MultimaterialContact, PresenceSkipsASliverOfEitherPartner) {
       }
 }
 
+// Under stick (presence_thin_along_normal) a sliver is absent only when its
+// domain is thin along the normal (its gradient within 45 degrees of n) and
+// its partner is present. A sliver beside a free edge (gradient across n)
+// and a node where both partners are slivers keep the stick (docs/
+// contact_validation.md §16). MVG normal a → b = +x from the present
+// partner's larger gradient. Per node and batched.
+TEST(MultimaterialContact, StickPresenceSkipsOnlyASliverThinAlongTheNormal) {
+  for (const bool batch : {false, true})
+    for (const int sliver : {0, 1})
+      for (const bool across : {false, true})
+        for (const bool both : {false, true}) {
+          TwoBodyNode t;
+          const int other = 1 - sliver;
+          const double side = sliver == 0 ? 1.0 : -1.0;  // outward gradients: n = g_a = -g_b
+          t.grid.set_gradient(other, 0, {-4.0 * side, 0, 0});
+          t.grid.set_gradient(sliver, 0,
+                              across ? std::array<double, 3>{0, 0.5 * side, 0}
+                                     : std::array<double, 3>{0.5 * side, 0, 0});
+          t.grid.vol[t.grid.at(sliver, 0)] = 0.28;
+          if (both) t.grid.vol[t.grid.at(other, 0)] = 0.28;
+          auto pp = contact_params<double>(Law::stick);
+          pp.normal_method = NormalMethod::mvg;
+          pp.presence_min_volume = 0.3;
+          pp.presence_thin_along_normal = true;
+          t.setup.connect(0, 1, pp);
+          t.setup.cfg.batch_pairs = batch;
+          MMStats stats;
+          std::vector<unsigned char> flags;
+          run_pass_a(t.grid, t.setup, stats, flags);
+          const bool absent = !across && !both;
+          for (int j = 0; j < 2; ++j)
+            EXPECT_NEAR(t.grid.velocity(j, 0, 0), absent ? (j == 0 ? 1.0 : -1.0) : -0.2, kTol)
+                << "batch " << batch << " sliver field " << sliver << " across " << across
+                << " both slivers " << both;
+        }
+  // The test reads g: a specified normal cannot take it.
+  TwoBodyNode t;
+  auto pp = contact_params<double>(Law::stick);
+  pp.presence_min_volume = 0.3;
+  pp.presence_thin_along_normal = true;
+  t.setup.connect(0, 1, pp);
+  EXPECT_NE(mmpm::validate_multimaterial(t.grid.view, t.setup.config()), nullptr);
+}
+
 TEST(MultimaterialContact, SeparatePairAndEmptyFieldDoNothing) {
   TwoBodyNode t;  // no connect(): pair table entry -1
   MMStats stats;
