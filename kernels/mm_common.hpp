@@ -39,14 +39,14 @@ inline constexpr double kRigidPresentFraction = 0.05;
 
 // Either material of a deformable frictionless pair whose nodal domain fills
 // less than this fraction of a cell is taken as absent at the node, under the
-// same separations and stencils as kRigidPresentFraction; under stick, only a
-// sliver thin along the normal that faces a present partner
-// (PairParams::presence_thin_along_normal); not under Coulomb
-// (MultimaterialStage says why). A uGIMP particle's domain reaches the next
-// node row as soon as it moves: a pressed face that travels e past a grid
-// line puts a sliver of about e^2 / (2 h^2) of a cell on the row beyond it
-// (0.3 % at e = 0.08 h), and the partner's load then entered one row too
-// deep: a stiff platen on a block stiffened by 1.7 % over 0.08 h of travel
+// same separations and stencils as kRigidPresentFraction; under stick and
+// Coulomb, only a sliver thin along the normal that faces a present partner
+// (PairParams::presence_thin_along_normal; MultimaterialStage says why). A
+// uGIMP particle's domain reaches the next node row as soon as it moves: a
+// pressed face that travels e past a grid line puts a sliver of about
+// e^2 / (2 h^2) of a cell on the row beyond it (0.3 % at e = 0.08 h), and
+// the partner's load then entered one row too deep: a stiff platen on a
+// block stiffened by 1.7 % over 0.08 h of travel
 // (docs/contact_validation.md §14). Smaller than the rigid fraction because
 // here both partners' slivers are screened: at 0.05 two blocks meeting at a
 // third of a cell past a grid line (linear shapes) exchanged their velocities
@@ -190,6 +190,14 @@ inline constexpr unsigned char kPassBRecord = kHeldInPassB | kStuckInPassB;
 // and only where the pass B before it held the pair.
 inline bool held_before(unsigned char stick, bool strain_pass) {
   return strain_pass && (stick & kHeldInPassB) != 0;
+}
+// Whether MUSL's strain pass sticks a Coulomb pair: where the pass B before it
+// held the pair inside its cone (kStuckInPassB). The re-extrapolated momenta
+// carry no normal push to bound the friction with, as USF's pass A's do not
+// (kStuckInPassB above): the cone of their own let the strain slide along a
+// face the particles held (docs/contact_validation.md §17).
+inline bool stuck_before(unsigned char stick, bool strain_pass) {
+  return held_before(stick, strain_pass) && (stick & kStuckInPassB) != 0;
 }
 
 // The stick flags with a one-sided normal decided by whether the pair approaches.

@@ -424,8 +424,11 @@ template <Law L, int D, class Real>
   const Real friction = B.params->friction;
   const int count = B.count;
   // As a 0/1 Real, for the reason given for sticks_tangential below.
+  // Held (1), or held stuck under Coulomb (2: stuck_before).
   for (int i = 0; i < count; ++i)
-    B.held[i] = held_before(B.stick[i], strain_pass) ? Real(1) : Real(0);
+    B.held[i] = stuck_before(B.stick[i], strain_pass)  ? Real(2)
+                : held_before(B.stick[i], strain_pass) ? Real(1)
+                                                       : Real(0);
   if constexpr (L == Law::interface) {
     // The tangential stick flag as a 0/1 Real in memory, for the loop below
     // to select on. A select on a test of the byte needs the byte lanes'
@@ -466,6 +469,11 @@ template <Law L, int D, class Real>
       const bool contact =
           ((dot<D, Real>(dp, n) < 0) & (B.dn[i] < 0)) | (B.held[i] != Real(0));  // in_contact
       change = contact_change_lane<L, D, Real>(contact, friction, dp, n, B.stuck[i]);
+      if constexpr (L == Law::friction) {  // stuck in pass B: sticks again (stuck_before)
+        const bool stuck_before_here = B.held[i] > Real(1);
+        for (int d = 0; d < D; ++d) change[d] = stuck_before_here ? dp[d] : change[d];
+        B.stuck[i] = stuck_before_here ? Real(1) : B.stuck[i];
+      }
       B.held[i] = contact ? Real(1) : Real(0);
     }
     for (int d = 0; d < D; ++d) B.change[d][i] = has_normal ? change[d] : Real(0);

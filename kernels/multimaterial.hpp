@@ -484,7 +484,7 @@ InteractionResult<D, Real> interact_pass_b(const MaterialSide<D, Real>& a,
   if (pp.law != Law::interface)
     return contact_result<D, Real>(
         G, pp, corrected_normal_separation(pp.separation, G.delta_n, G.h_perp, pp.contact_offset),
-        held_before(stick_flags, strain_pass));
+        held_before(stick_flags, strain_pass), stuck_before(stick_flags, strain_pass));
   return interface_stick_result<D, Real>(G, stick_flags, strain_pass);
 }
 
@@ -504,7 +504,8 @@ InteractionResult<D, Real> interact_pass_b_saved(const MaterialSide<D, Real>& a,
   G.n = saved.n;
   G.dp = momentum_change_to_center_of_mass<D, Real>(a.m, a.p, b.m, b.p, b_is_rigid);
   if (pp.law != Law::interface)
-    return contact_result<D, Real>(G, pp, saved.dn, held_before(stick_flags, strain_pass));
+    return contact_result<D, Real>(G, pp, saved.dn, held_before(stick_flags, strain_pass),
+                                   stuck_before(stick_flags, strain_pass));
   return interface_stick_result<D, Real>(G, stick_flags, strain_pass);
 }
 

@@ -60,19 +60,18 @@ class MultimaterialStage {
           (scene.grid.shape == ShapeKind::linear || scene.grid.shape == ShapeKind::gimp);
       if (presence_tested) pp.rigid_min_volume = Real(kRigidPresentFraction * cell);
       // Both partners' presence (kContactPresentFraction), same stencils and
-      // separations. Frictionless: either partner's sliver. Stick: only a
-      // sliver thin along the normal facing a present partner (read off the
-      // domain gradients, so not with a specified or radial normal); one
+      // separations. Frictionless: either partner's sliver. Stick and Coulomb:
+      // only a sliver thin along the normal facing a present partner (read off
+      // the domain gradients, so not with a specified or radial normal); one
       // beside a free edge carries the corner's shear, and screened it made a
-      // uGIMP block's free corner ring under a stiff platen. Not for Coulomb:
-      // with either form a stiff platen's top face slid off (every sliver:
-      // in a hold, gaining 10 % of the work; stick's form: during the drive
-      // at h = 0.125). Not for an interface, which is bonded at every node
-      // both materials share (docs/contact_validation.md §15, §16).
-      const bool stick_presence = it.law == Law::stick && reads_domain_gradient(pp);
-      if (presence_tested && (it.law == Law::frictionless || stick_presence))
+      // uGIMP block's free corner ring under a stiff platen. Not for an
+      // interface, which is bonded at every node both materials share
+      // (docs/contact_validation.md §15-17).
+      const bool tangential_tie =
+          (it.law == Law::stick || it.law == Law::friction) && reads_domain_gradient(pp);
+      if (presence_tested && (it.law == Law::frictionless || tangential_tie))
         pp.presence_min_volume = Real(kContactPresentFraction * cell);
-      pp.presence_thin_along_normal = stick_presence;
+      pp.presence_thin_along_normal = tangential_tie;
       pp.force_limit = it.force_limit;
       pp.integration = it.integration;
       pp.closed_area = it.law == Law::interface && it.area == ContactArea::closed;
