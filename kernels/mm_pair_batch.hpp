@@ -423,8 +423,8 @@ template <Law L, int D, class Real>
 [[gnu::flatten]] void pass_b_lanes(PairBatch<D, Real>& B, bool strain_pass) {
   const Real friction = B.params->friction;
   const int count = B.count;
-  // As a 0/1 Real, for the reason given for sticks_tangential below.
-  // Held (1), or held stuck under Coulomb (2: stuck_before).
+  // Held (1), or held stuck under Coulomb (2: stuck_before), as a Real, for
+  // the reason given for sticks_tangential below.
   for (int i = 0; i < count; ++i)
     B.held[i] = stuck_before(B.stick[i], strain_pass)  ? Real(2)
                 : held_before(B.stick[i], strain_pass) ? Real(1)
