@@ -351,6 +351,30 @@ TEST(Determinism, FrictionContactTwoBlocksApproachingUSF2D) {
   check_friction_contact("USF");
 }
 
+// normal = "geometry" turns the rigid floor's gradients to its rotated box
+// before pass A (solver/rigid_normals.hpp): the block slides down the
+// incline of inputs/rotated_incline.toml the same, bit for bit, on 1 and
+// 2 threads (1000 steps: past the gravity ramp, sliding).
+TEST(Determinism, RotatedInclineGeometryNormal2D) {
+  const Scene scene =
+      parse_scene_file(mmpm_test::source_dir() + "/inputs/rotated_incline.toml", {});
+  const int saved = omp_get_max_threads();
+  auto run_incline = [&](int threads) {
+    omp_set_num_threads(threads);
+    auto sim = make_simulation(scene);
+    RunResult r;
+    r.particles = sim->particle_count();
+    r.initial_position = sim->particle_field("position").values;
+    for (int k = 0; k < 1000; ++k) sim->step();
+    record_end(*sim, r);
+    return r;
+  };
+  const RunResult one = run_incline(1), two = run_incline(2);
+  omp_set_num_threads(saved);
+  EXPECT_GT(one.counters.multimaterial_nodes, 0) << "the block must be on the floor";
+  expect_identical(one, two);
+}
+
 std::string scene_3d() {
   return R"(
 [simulation]

@@ -28,31 +28,6 @@ Vec3 box_center(const BodySpec& b) {
   return {0.5 * (b.min[0] + b.max[0]), 0.5 * (b.min[1] + b.max[1]), 0.5 * (b.min[2] + b.max[2])};
 }
 
-// Global → body frame for a box rotated by `rotate` degrees about its centre (2D).
-Vec3 to_body_frame(const BodySpec& b, const Vec3& x) {
-  if (b.rotate == 0.0) return x;
-  const Vec3 c = box_center(b);
-  const double a = -b.rotate * std::numbers::pi / 180.0;
-  const double dx = x[0] - c[0], dy = x[1] - c[1];
-  return {c[0] + std::cos(a) * dx - std::sin(a) * dy, c[1] + std::sin(a) * dx + std::cos(a) * dy,
-          x[2]};
-}
-
-Vec3 rotate_vector(const BodySpec& b, const Vec3& v) {
-  if (b.rotate == 0.0) return v;
-  const double a = b.rotate * std::numbers::pi / 180.0;
-  return {std::cos(a) * v[0] - std::sin(a) * v[1], std::sin(a) * v[0] + std::cos(a) * v[1], v[2]};
-}
-
-bool inside_polygon(const std::vector<Vec3>& pts, double x, double y) {
-  bool in = false;
-  for (std::size_t i = 0, j = pts.size() - 1; i < pts.size(); j = i++) {
-    const double xi = pts[i][0], yi = pts[i][1], xj = pts[j][0], yj = pts[j][1];
-    if ((yi > y) != (yj > y) && x < (xj - xi) * (y - yi) / (yj - yi) + xi) in = !in;
-  }
-  return in;
-}
-
 // Bounding box of a body in global coordinates.
 std::pair<Vec3, Vec3> bounds(const BodySpec& b, int dim) {
   Vec3 lo{0, 0, 0}, hi{0, 0, 0};
@@ -136,6 +111,31 @@ class SeedCells {
 };
 
 }  // namespace
+
+bool inside_polygon(const std::vector<Vec3>& pts, double x, double y) {
+  bool in = false;
+  for (std::size_t i = 0, j = pts.size() - 1; i < pts.size(); j = i++) {
+    const double xi = pts[i][0], yi = pts[i][1], xj = pts[j][0], yj = pts[j][1];
+    if ((yi > y) != (yj > y) && x < (xj - xi) * (y - yi) / (yj - yi) + xi) in = !in;
+  }
+  return in;
+}
+
+// Global → body frame for a box rotated by `rotate` degrees about its centre (2D).
+Vec3 to_body_frame(const BodySpec& b, const Vec3& x) {
+  if (b.rotate == 0.0) return x;
+  const Vec3 c = box_center(b);
+  const double a = -b.rotate * std::numbers::pi / 180.0;
+  const double dx = x[0] - c[0], dy = x[1] - c[1];
+  return {c[0] + std::cos(a) * dx - std::sin(a) * dy, c[1] + std::sin(a) * dx + std::cos(a) * dy,
+          x[2]};
+}
+
+Vec3 rotate_vector(const BodySpec& b, const Vec3& v) {
+  if (b.rotate == 0.0) return v;
+  const double a = b.rotate * std::numbers::pi / 180.0;
+  return {std::cos(a) * v[0] - std::sin(a) * v[1], std::sin(a) * v[0] + std::cos(a) * v[1], v[2]};
+}
 
 bool inside_body(const BodySpec& b, const Vec3& x, int dim) {
   if (b.clip) {

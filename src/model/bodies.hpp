@@ -28,6 +28,14 @@ struct ParticleSeeds {
 // no particle on its face.
 ParticleSeeds make_particles(const Scene& scene);
 
+// Global → body frame for a body turned by `rotate` degrees about its
+// pivot (2D; the identity when rotate = 0), and a vector turned back.
+Vec3 to_body_frame(const BodySpec& b, const Vec3& x);
+Vec3 rotate_vector(const BodySpec& b, const Vec3& v);
+
+// Whether (x, y) lies inside the polygon (even–odd rule).
+bool inside_polygon(const std::vector<Vec3>& points, double x, double y);
+
 // Whether point x lies inside body b (in global coordinates).
 bool inside_body(const BodySpec& b, const Vec3& x, int dimension);
 

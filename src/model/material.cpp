@@ -1,7 +1,9 @@
 #include "model/material.hpp"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "scene/error.hpp"
 
@@ -151,6 +153,29 @@ Vec3 rigid_velocity(const MaterialSpec& spec, double t) {
     }
   }
   return tab.velocity.back();
+}
+
+// ∫_0^t of rigid_velocity: the piecewise-linear table integrated exactly,
+// each segment by its trapezoid, the end values held before and after it.
+Vec3 rigid_displacement(const MaterialSpec& spec, double t) {
+  const auto& tab = spec.velocity;
+  Vec3 u{0, 0, 0};
+  if (tab.velocity.empty() || t <= 0) return u;
+  auto add = [&](double t0, double t1) {  // [t0, t1] within [0, t]
+    const double a = std::max(t0, 0.0), b = std::min(t1, t);
+    if (b <= a) return;
+    const Vec3 va = rigid_velocity(spec, a), vb = rigid_velocity(spec, b);
+    for (int d = 0; d < 3; ++d) u[d] += 0.5 * (va[d] + vb[d]) * (b - a);
+  };
+  const double inf = std::numeric_limits<double>::infinity();
+  if (tab.velocity.size() == 1) {
+    add(-inf, inf);
+    return u;
+  }
+  add(-inf, tab.time.front());
+  for (std::size_t k = 1; k < tab.time.size(); ++k) add(tab.time[k - 1], tab.time[k]);
+  add(tab.time.back(), inf);
+  return u;
 }
 
 }  // namespace mmpm

@@ -28,4 +28,7 @@ MaterialModel make_material(const MaterialSpec& spec, int dimension, Plane plane
 // Velocity of a rigid material at time t (piecewise linear, held at the ends).
 Vec3 rigid_velocity(const MaterialSpec& spec, double t);
 
+// Its displacement from time 0 to t (the integral of rigid_velocity).
+Vec3 rigid_displacement(const MaterialSpec& spec, double t);
+
 }  // namespace mmpm

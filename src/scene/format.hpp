@@ -53,12 +53,13 @@ inline constexpr std::array<EnumName<Law>, 5> kLawNames{{{"stick", Law::stick},
 // have nowhere to give a friction coefficient or interface stiffnesses.
 inline constexpr std::array<EnumName<Law>, 3> kDefaultLawNames{
     {{"stick", Law::stick}, {"frictionless", Law::frictionless}, {"separate", Law::separate}}};
-inline constexpr std::array<EnumName<NormalMethod>, 5> kNormalMethodNames{
+inline constexpr std::array<EnumName<NormalMethod>, 6> kNormalMethodNames{
     {{"mvg", NormalMethod::mvg},
      {"avg", NormalMethod::avg},
      {"specified", NormalMethod::specified},
      {"radial", NormalMethod::radial},
-     {"rigid", NormalMethod::rigid}}};
+     {"rigid", NormalMethod::rigid},
+     {"geometry", NormalMethod::geometry}}};
 inline constexpr std::array<EnumName<Separation>, 3> kSeparationNames{
     {{"displacement", Separation::displacement},
      {"position", Separation::position},

@@ -21,7 +21,8 @@ enum class ShapeKind { linear, gimp, bspline2, bspline3 };
 enum class MaterialType { isotropic, transverse, neohookean, rigid };
 enum class BodyShape { box, disk, sphere, cylinder, polygon };
 enum class Law { stick, frictionless, friction, interface, separate };
-enum class NormalMethod { mvg, avg, specified, radial, rigid };
+// geometry: the rigid partner's outward normal from its bodies (model/rigid_surface.hpp)
+enum class NormalMethod { mvg, avg, specified, radial, rigid, geometry };
 // extrapolated: displacement at the node, not at the centroid
 // (kernels/separation_extrapolation.hpp)
 enum class Separation { displacement, position, extrapolated };

@@ -39,7 +39,7 @@ inline std::vector<std::size_t> materials_in_field(const FieldPlan& plan, int fi
 inline bool needs_domain_gradient(const FieldPlan& plan) {
   for (const InteractionSpec& it : plan.laws)
     if (it.normal == NormalMethod::mvg || it.normal == NormalMethod::avg ||
-        it.normal == NormalMethod::rigid ||
+        it.normal == NormalMethod::rigid || it.normal == NormalMethod::geometry ||
         (it.law == Law::interface && it.area == ContactArea::closed))
       return true;
   return false;

@@ -38,7 +38,9 @@ class MultimaterialStage {
       pp.Dt = Real(it.Dt);
       pp.traction_law = it.traction_law;
       pp.Dn_compression = Real(it.Dn_compression);
-      pp.normal_method = it.normal;
+      // "geometry" is the rigid normal read from a gradient the stepper has
+      // turned to the rigid body's faces (Stepper::orient_rigid_gradients).
+      pp.normal_method = it.normal == NormalMethod::geometry ? NormalMethod::rigid : it.normal;
       for (int d = 0; d < 3; ++d) {
         pp.normal_vector[d] = Real(it.normal_vector[d]);
         pp.radial_center[d] = Real(it.center[d]);

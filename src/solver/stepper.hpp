@@ -35,6 +35,7 @@
 #include "solver/field_plan.hpp"
 #include "solver/multimaterial_stage.hpp"
 #include "solver/ramp.hpp"
+#include "solver/rigid_normals.hpp"
 #include "solver/simulation.hpp"
 #include "solver/storage.hpp"
 
@@ -273,7 +274,8 @@ class Stepper final : public Simulation {
   std::array<const Real*, D> face_offset_{};
 
   MultimaterialStage<D, Real> mm_;
-  std::vector<double> rigid_velocity_now_;  // per field x 3 at t + dt
+  std::vector<RigidSurfaceField> rigid_surfaces_;  // normal = "geometry" (solver/rigid_normals.hpp)
+  std::vector<double> rigid_velocity_now_;         // per field x 3 at t + dt
   std::vector<Vec3> boundary_reaction_;
   std::vector<SupportView<Real>> support_views_;    // per boundary, over boundaries_' lists
   std::vector<std::vector<double>> support_terms_;  // per boundary: reaction terms

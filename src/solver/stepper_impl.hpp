@@ -39,6 +39,7 @@ Stepper<D, Shape, Real>::Stepper(const Scene& scene) : scene_(scene), plan_(plan
   setup_particles(make_particles(scene));
   setup_mirrors();
   mm_.setup(scene, plan_, G_, Real(min_particle_mass_), dt_);
+  rigid_surfaces_ = rigid_surface_fields(scene, plan_);
   support_views_.resize(boundaries_.size());
   support_terms_.resize(boundaries_.size());
   for (std::size_t b = 0; b < boundaries_.size(); ++b)
@@ -1156,6 +1157,8 @@ void Stepper<D, Shape, Real>::step() {
     p2g_multimaterial();
     toc(kStageP2G);
     tic();
+    if (!rigid_surfaces_.empty())
+      orient_rigid_gradients(G_, mm_.nodes(), rigid_surfaces_, scene_, time_);
     mm_.pass_a(G_, dt_, regular_dt_, own_);  // 0: decide for dt_
     toc(kStageMultimaterial);
   }
