@@ -351,8 +351,9 @@ TEST(Determinism, FrictionContactTwoBlocksApproachingUSF2D) {
   check_friction_contact("USF");
 }
 
-// normal = "geometry" turns the rigid floor's gradients to its rotated box
-// before pass A (solver/rigid_normals.hpp): the block slides down the
+// normal = "geometry" turns the floor's and the block's gradients to their
+// boxes before pass A, the block's carried by the motion fitted to its
+// particles (solver/geometry_normals.hpp): the block slides down the
 // incline of inputs/rotated_incline.toml the same, bit for bit, on 1 and
 // 2 threads (1000 steps: past the gravity ramp, sliding).
 TEST(Determinism, RotatedInclineGeometryNormal2D) {

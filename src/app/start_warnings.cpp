@@ -153,11 +153,11 @@ bool has_slanted_face(const BodySpec& b) {
 }
 
 // docs/contact_validation.md §4.4: the normals computed from the particles
-// of a slanted rigid face scatter by up to 25° from node to node, and a
-// contact stops or slows a slide along it (a 20° incline of rotated boxes,
+// of a slanted face scatter by up to 25° from node to node, and a contact
+// stops or slows a slide along it (a 20° incline of rotated boxes,
 // frictionless: mvg -0.009, avg -0.004, rigid 13.8 against 34.2 mm/ms^2).
 // normal = "geometry" reads that face from the body (§18).
-std::vector<std::string> slanted_rigid_face_warnings(const Scene& scene) {
+std::vector<std::string> slanted_face_warnings(const Scene& scene) {
   std::vector<std::string> out;
   for (std::size_t k = 0; k < scene.interactions.size(); ++k) {
     const InteractionSpec& it = scene.interactions[k];
@@ -168,16 +168,15 @@ std::vector<std::string> slanted_rigid_face_warnings(const Scene& scene) {
     if (!contact || !computed) continue;
     for (const BodySpec& b : scene.bodies) {
       if (b.material != it.materials[0] && b.material != it.materials[1]) continue;
-      const MaterialSpec& m = scene.materials[std::size_t(scene.material_index(b.material))];
-      if (m.type != MaterialType::rigid || !has_slanted_face(b)) continue;
+      if (!has_slanted_face(b)) continue;
       std::ostringstream w;
       w << interaction_warning(scene, k, "normal") << "normal = \"" << scene_name(it.normal)
-        << "\" against rigid body '" << b.name
+        << "\" on body '" << b.name
         << "', which has a face at an angle to the grid: its particles fill that face as a "
            "staircase, the computed normals scatter around the face's, and contact stops or "
            "slows a slide along it (a 20-degree incline of rotated boxes, frictionless: mvg "
-           "-0.009, rigid 13.8 against 34.2 mm/ms^2); normal = \"geometry\" takes the normal "
-           "from the body's shape";
+           "-0.009, rigid 13.8 against 34.2 mm/ms^2); normal = \"geometry\" takes the normals "
+           "from the bodies' shapes";
       out.push_back(w.str());
       break;
     }
@@ -196,7 +195,7 @@ std::vector<std::string> start_warnings(const Scene& scene, const Simulation& si
   for (std::string& w : extrapolated_separation_warnings(scene)) out.push_back(std::move(w));
   for (std::string& w : computed_normal_warnings(scene)) out.push_back(std::move(w));
   for (std::string& w : position_offset_warnings(scene)) out.push_back(std::move(w));
-  for (std::string& w : slanted_rigid_face_warnings(scene)) out.push_back(std::move(w));
+  for (std::string& w : slanted_face_warnings(scene)) out.push_back(std::move(w));
   return out;
 }
 

@@ -112,6 +112,16 @@ class SeedCells {
 
 }  // namespace
 
+Vec3 rotation_centre(const BodySpec& b) {
+  return box_center(b);
+}
+
+std::pair<Vec3, Vec3> shape_bounds(const BodySpec& b, int dimension) {
+  BodySpec shape = b;
+  shape.clip.reset();
+  return bounds(shape, dimension);
+}
+
 bool inside_polygon(const std::vector<Vec3>& pts, double x, double y) {
   bool in = false;
   for (std::size_t i = 0, j = pts.size() - 1; i < pts.size(); j = i++) {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <utility>
 #include <vector>
 
 #include "scene/scene.hpp"
@@ -32,6 +33,12 @@ ParticleSeeds make_particles(const Scene& scene);
 // pivot (2D; the identity when rotate = 0), and a vector turned back.
 Vec3 to_body_frame(const BodySpec& b, const Vec3& x);
 Vec3 rotate_vector(const BodySpec& b, const Vec3& v);
+
+// The point a body turns about by `rotate`: its pivot, or its centre.
+Vec3 rotation_centre(const BodySpec& b);
+
+// The bounding box of a body's shape, its clip box left out.
+std::pair<Vec3, Vec3> shape_bounds(const BodySpec& b, int dimension);
 
 // Whether (x, y) lies inside the polygon (even–odd rule).
 bool inside_polygon(const std::vector<Vec3>& points, double x, double y);

@@ -1393,11 +1393,10 @@ class SceneReader {
             "axis through center)");
       in.radial_axis = normalized(*f, f->vec(3));
     }
-    const bool from_rigid = in.normal == NormalMethod::rigid || in.normal == NormalMethod::geometry;
-    if (from_rigid && a.type != MaterialType::rigid && b.type != MaterialType::rigid) {
-      method->fail("normal = " + quote(scene_name(in.normal)) +
-                   " needs one of the two materials to be rigid; " + quote(a.name) + " and " +
-                   quote(b.name) + " are not");
+    if (in.normal == NormalMethod::rigid && a.type != MaterialType::rigid &&
+        b.type != MaterialType::rigid) {
+      method->fail("normal = \"rigid\" needs one of the two materials to be rigid; " +
+                   quote(a.name) + " and " + quote(b.name) + " are not");
     }
   }
 

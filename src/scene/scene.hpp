@@ -21,7 +21,7 @@ enum class ShapeKind { linear, gimp, bspline2, bspline3 };
 enum class MaterialType { isotropic, transverse, neohookean, rigid };
 enum class BodyShape { box, disk, sphere, cylinder, polygon };
 enum class Law { stick, frictionless, friction, interface, separate };
-// geometry: the rigid partner's outward normal from its bodies (model/rigid_surface.hpp)
+// geometry: outward normals from the bodies' shapes (model/shape_surface.hpp)
 enum class NormalMethod { mvg, avg, specified, radial, rigid, geometry };
 // extrapolated: displacement at the node, not at the centroid
 // (kernels/separation_extrapolation.hpp)

@@ -3,7 +3,6 @@
 #include <algorithm>
 
 #include "scene/error.hpp"
-#include "scene/format.hpp"
 
 namespace mmpm {
 
@@ -89,13 +88,11 @@ FieldPlan plan_fields(const Scene& scene) {
     for (std::size_t b = 0; b < F; ++b) {
       const int l = plan.pair[a * F + b];
       if (l < 0 || a == b) continue;
-      const NormalMethod n = plan.laws[std::size_t(l)].normal;
-      if ((n == NormalMethod::rigid || n == NormalMethod::geometry) && !plan.rigid[a] &&
+      if (plan.laws[std::size_t(l)].normal == NormalMethod::rigid && !plan.rigid[a] &&
           !plan.rigid[b]) {
         const auto& w = plan.laws[std::size_t(l)].where;
         throw InputError(
-            located(w.file, w.line, "normal",
-                    "\"" + std::string(scene_name(n)) + "\" needs one rigid material in the pair"));
+            located(w.file, w.line, "normal", "\"rigid\" needs one rigid material in the pair"));
       }
     }
   return plan;

@@ -38,8 +38,9 @@ class MultimaterialStage {
       pp.Dt = Real(it.Dt);
       pp.traction_law = it.traction_law;
       pp.Dn_compression = Real(it.Dn_compression);
-      // "geometry" is the rigid normal read from a gradient the stepper has
-      // turned to the rigid body's faces (Stepper::orient_rigid_gradients).
+      // "geometry" reads gradients the stepper has turned to the bodies'
+      // faces (solver/geometry_normals.hpp) as "rigid" does: the rigid
+      // partner's, or MVG's steeper of two deformable ones.
       pp.normal_method = it.normal == NormalMethod::geometry ? NormalMethod::rigid : it.normal;
       for (int d = 0; d < 3; ++d) {
         pp.normal_vector[d] = Real(it.normal_vector[d]);

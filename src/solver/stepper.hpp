@@ -33,9 +33,9 @@
 #include "scene/error.hpp"
 #include "solver/boundary.hpp"
 #include "solver/field_plan.hpp"
+#include "solver/geometry_normals.hpp"
 #include "solver/multimaterial_stage.hpp"
 #include "solver/ramp.hpp"
-#include "solver/rigid_normals.hpp"
 #include "solver/simulation.hpp"
 #include "solver/storage.hpp"
 
@@ -274,8 +274,12 @@ class Stepper final : public Simulation {
   std::array<const Real*, D> face_offset_{};
 
   MultimaterialStage<D, Real> mm_;
-  std::vector<RigidSurfaceField> rigid_surfaces_;  // normal = "geometry" (solver/rigid_normals.hpp)
-  std::vector<double> rigid_velocity_now_;         // per field x 3 at t + dt
+  // normal = "geometry" (solver/geometry_normals.hpp): the fields it turns,
+  // and each particle id's scene body (for deformable bodies' motions).
+  std::vector<GeometryNormalField> geometry_fields_;
+  std::vector<std::array<std::size_t, 2>> geometry_pairs_;
+  std::vector<int> body_of_id_;
+  std::vector<double> rigid_velocity_now_;  // per field x 3 at t + dt
   std::vector<Vec3> boundary_reaction_;
   std::vector<SupportView<Real>> support_views_;    // per boundary, over boundaries_' lists
   std::vector<std::vector<double>> support_terms_;  // per boundary: reaction terms

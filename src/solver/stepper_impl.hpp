@@ -36,10 +36,11 @@ Stepper<D, Shape, Real>::Stepper(const Scene& scene) : scene_(scene), plan_(plan
   }
   domain_gradient_ = plan_.multimaterial && needs_domain_gradient(plan_);
   setup_grid();
+  geometry_fields_ = geometry_normal_fields(scene, plan_);
+  geometry_pairs_ = geometry_normal_pairs(geometry_fields_, plan_);
   setup_particles(make_particles(scene));
   setup_mirrors();
   mm_.setup(scene, plan_, G_, Real(min_particle_mass_), dt_);
-  rigid_surfaces_ = rigid_surface_fields(scene, plan_);
   support_views_.resize(boundaries_.size());
   support_terms_.resize(boundaries_.size());
   for (std::size_t b = 0; b < boundaries_.size(); ++b)
@@ -121,6 +122,9 @@ template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::setup_particles(const ParticleSeeds& seeds) {
   const std::size_t n = seeds.x.size();
   P_.n = n;
+  if (std::any_of(geometry_fields_.begin(), geometry_fields_.end(),
+                  [](const GeometryNormalField& f) { return f.rigid_material < 0; }))
+    body_of_id_ = seeds.body;  // ids number the seeds (the column id, last below)
   const char* axis = "xyz";
   const bool finite = std::any_of(materials_.begin(), materials_.end(),
                                   [](const MaterialModel& m) { return m.finite_strain(); });
@@ -1157,8 +1161,14 @@ void Stepper<D, Shape, Real>::step() {
     p2g_multimaterial();
     toc(kStageP2G);
     tic();
-    if (!rigid_surfaces_.empty())
-      orient_rigid_gradients(G_, mm_.nodes(), rigid_surfaces_, scene_, time_);
+    if (!geometry_fields_.empty()) {
+      move_rigid_shapes(geometry_fields_, scene_, time_);
+      fit_body_motions(geometry_fields_, P_, pcols_.id.data(), P_.n, body_of_id_,
+                       scene_.bodies.size());
+      double cell = 0;
+      for (int d = 0; d < D; ++d) cell = std::max(cell, double(G_.h[d]));
+      orient_gradients(G_, mm_.nodes(), geometry_fields_, geometry_pairs_, 0.5 * Shape::S * cell);
+    }
     mm_.pass_a(G_, dt_, regular_dt_, own_);  // 0: decide for dt_
     toc(kStageMultimaterial);
   }

@@ -1,6 +1,7 @@
-// normal = "geometry": a rigid material's outward normal from its bodies'
-// shapes (model/rigid_surface.hpp) and the gradients it turns before pass A
-// (solver/rigid_normals.hpp). Exact geometry, so 1e-12.
+// normal = "geometry": a material's outward normal from its bodies' shapes
+// (model/shape_surface.hpp), the motion that carries them, and the
+// gradients it turns before pass A (solver/geometry_normals.hpp). Exact
+// geometry, so 1e-12.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,10 +10,10 @@
 #include <vector>
 
 #include "model/material.hpp"
-#include "model/rigid_surface.hpp"
+#include "model/shape_surface.hpp"
 #include "scene/parse.hpp"
 #include "solver/field_plan.hpp"
-#include "solver/rigid_normals.hpp"
+#include "solver/geometry_normals.hpp"
 
 namespace mmpm {
 namespace {
@@ -56,12 +57,12 @@ min = [-7.0, 5.0]
 max = [-6.0, 6.0]
 )";
 
-RigidSurface wall_surface(const Scene& scene) {
-  return RigidSurface(scene, {std::size_t(scene.material_index("wall"))});
+ShapeSurface wall_surface(const Scene& scene) {
+  return ShapeSurface(scene, {std::size_t(scene.material_index("wall"))});
 }
 
-void expect_normal(const RigidSurface& s, Vec3 x, Vec3 n, const char* where) {
-  const Vec3 got = s.outward_normal(x);
+void expect_normal(const ShapeSurface& s, Vec3 x, Vec3 n, const char* where) {
+  const Vec3 got = s.distance(x).gradient;
   for (int d = 0; d < 3; ++d) EXPECT_NEAR(got[d], n[d], kTol) << where << " component " << d;
 }
 
@@ -69,7 +70,7 @@ void expect_normal(const RigidSurface& s, Vec3 x, Vec3 n, const char* where) {
 // just inside and just outside, the normal is the face's (-sin, cos); at
 // its lower end the end face's (cos, sin) inside, and past the end's
 // corner the direction from the corner.
-TEST(RigidSurface, RotatedBoxGivesItsFacesNormals) {
+TEST(ShapeSurface, RotatedBoxGivesItsFacesNormals) {
   const Scene scene = parse_scene_text(scene_2d(std::string(kBlock) + R"(
 [[body]]
 material = "wall"
@@ -80,7 +81,7 @@ rotate = 20.0
 pivot = [0.0, 0.0]
 )"),
                                        "slab.toml");
-  const RigidSurface s = wall_surface(scene);
+  const ShapeSurface s = wall_surface(scene);
   const double th = 20.0 * std::numbers::pi / 180.0;
   const Vec3 t{std::cos(th), std::sin(th), 0}, n{-std::sin(th), std::cos(th), 0};
   for (double along : {-4.0, -1.3, 0.0, 2.7, 4.5})
@@ -99,14 +100,14 @@ pivot = [0.0, 0.0]
 }
 
 // A wedge given clockwise and counter-clockwise: the same outward normals.
-TEST(RigidSurface, PolygonNormalsDoNotDependOnItsWinding) {
+TEST(ShapeSurface, PolygonNormalsDoNotDependOnItsWinding) {
   for (const char* points :
        {"[[-4.0, -4.0], [4.0, -4.0], [4.0, 0.0]]", "[[4.0, 0.0], [4.0, -4.0], [-4.0, -4.0]]"}) {
     const Scene scene = parse_scene_text(
         scene_2d(std::string(kBlock) + "[[body]]\nmaterial = \"wall\"\nshape = \"polygon\"\n" +
                  "points = " + points + "\n"),
         "wedge.toml");
-    const RigidSurface s = wall_surface(scene);
+    const ShapeSurface s = wall_surface(scene);
     const double l = std::hypot(8.0, 4.0);
     const Vec3 slope{-4.0 / l, 8.0 / l, 0};  // the hypotenuse, facing up and left
     expect_normal(s, {0.0, -2.0 + 0.1, 0}, slope, points);
@@ -118,7 +119,7 @@ TEST(RigidSurface, PolygonNormalsDoNotDependOnItsWinding) {
 
 // The clip box cuts the disk; a later block of another material takes a
 // notch out of the wall's box, whose floor then faces up into the notch.
-TEST(RigidSurface, ClipBoxesAndLaterBodiesCutTheSurface) {
+TEST(ShapeSurface, ClipBoxesAndLaterBodiesCutTheSurface) {
   const Scene scene = parse_scene_text(scene_2d(R"(
 [[body]]
 material = "wall"
@@ -138,7 +139,7 @@ min = [-1.0, -1.0]
 max = [1.0, 2.0]
 )"),
                                        "cut.toml");
-  const RigidSurface s = wall_surface(scene);
+  const ShapeSurface s = wall_surface(scene);
   expect_normal(s, {0.0, 3.1, 0}, {0, -1, 0}, "the clip's face");
   expect_normal(s, {1.2, 5.6, 0}, {0.6, 0.8, 0}, "the disk");
   expect_normal(s, {0.0, -0.9, 0}, {0, 1, 0}, "the notch's floor, inside the wall");
@@ -148,7 +149,7 @@ max = [1.0, 2.0]
 }
 
 // A cylinder along a tilted axis (3D): radial on its side, the axis past its end.
-TEST(RigidSurface, CylinderSideAndEnd) {
+TEST(ShapeSurface, CylinderSideAndEnd) {
   BodySpec b;
   b.shape = BodyShape::cylinder;
   b.center = {1.0, 2.0, 3.0};
@@ -172,7 +173,7 @@ TEST(RigidSurface, CylinderSideAndEnd) {
 
 // The displacement of a rigid table: the exact integral, against a fine
 // midpoint sum of rigid_velocity.
-TEST(RigidSurface, RigidDisplacementIntegratesTheVelocityTable) {
+TEST(ShapeSurface, RigidDisplacementIntegratesTheVelocityTable) {
   MaterialSpec m;
   m.velocity.time = {0.5, 1.0, 3.0};
   m.velocity.velocity = {{1.0, 0.0, 0.0}, {-2.0, 4.0, 0.0}, {0.0, 1.0, 0.0}};
@@ -188,10 +189,55 @@ TEST(RigidSurface, RigidDisplacementIntegratesTheVelocityTable) {
   }
 }
 
-// Before pass A the wall's gradient at each listed node turns to the
-// normal of its moved shape and keeps its length; the block's field, and
-// a node where the wall has no gradient, keep theirs.
-TEST(RigidSurface, OrientRigidGradientsFollowsTheMovingShape) {
+// A body turned by 30 degrees about (1, 2) and moved by (0.5, -0.25): the
+// moments of its particles give back that motion, in 2D (closed form) and
+// in 3D (Kabsch, about a tilted axis), and the shape's normals turn with it.
+TEST(ShapeSurface, BodyMomentsGiveBackARigidMotion) {
+  const double a = 30.0 * std::numbers::pi / 180.0;
+  BodyMoments m2;
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 3; ++j) {
+      const Vec3 X{0.3 * i, 0.7 * j - 0.4, 0};
+      const double dx = X[0] - 1.0, dy = X[1] - 2.0;
+      const Vec3 x{1.5 + std::cos(a) * dx - std::sin(a) * dy,
+                   1.75 + std::sin(a) * dx + std::cos(a) * dy, 0};
+      m2.add(0.1 + 0.01 * i, X, x);
+    }
+  const BodyMotion f = m2.motion(2);
+  EXPECT_NEAR(f.R[0], std::cos(a), kTol);
+  EXPECT_NEAR(f.R[1], -std::sin(a), kTol);
+  EXPECT_NEAR(f.R[3], std::sin(a), kTol);
+  const Vec3 X = f.to_reference({1.5, 1.75, 0});  // where (1, 2) went
+  EXPECT_NEAR(X[0], 1.0, kTol);
+  EXPECT_NEAR(X[1], 2.0, kTol);
+
+  // 3D: 40 degrees about the unit axis (1, 2, 2) / 3 (Rodrigues), moved by (1, -2, 3).
+  const double k[3] = {1.0 / 3, 2.0 / 3, 2.0 / 3}, b = 40.0 * std::numbers::pi / 180.0;
+  double R[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      R[i][j] = (i == j ? std::cos(b) : 0.0) + (1 - std::cos(b)) * k[i] * k[j] +
+                std::sin(b) * (i == j ? 0.0 : ((i + 1) % 3 == j ? -k[3 - i - j] : k[3 - i - j]));
+  BodyMoments m3;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      for (int l = 0; l < 2; ++l) {
+        const Vec3 Y{0.5 * i, 0.4 * j, 0.9 * l};
+        Vec3 y{1.0, -2.0, 3.0};
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c) y[r] += R[r][c] * Y[c];
+        m3.add(1.0, Y, y);
+      }
+  const BodyMotion g = m3.motion(3);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) EXPECT_NEAR(g.R[3 * i + j], R[i][j], 1e-10) << i << j;
+}
+
+// Before pass A each geometry field's gradient at the listed nodes turns to
+// the normal of its moved shape and keeps its length: the rigid wall's
+// disk moved by its velocity, the block by the motion fitted to it; a
+// node where a field has no gradient keeps its zero.
+TEST(ShapeSurface, OrientGradientsFollowsTheMovingShapes) {
   const Scene scene = parse_scene_text(scene_2d(std::string(kBlock) + R"(
 [[body]]
 material = "wall"
@@ -202,9 +248,14 @@ radius = 2.0
                                                 "[3.0, -1.0]"),
                                        "moving.toml");
   const FieldPlan plan = plan_fields(scene);
-  const std::vector<RigidSurfaceField> surfaces = rigid_surface_fields(scene, plan);
-  ASSERT_EQ(surfaces.size(), 1u);
-  const int wall = surfaces[0].field, block = 1 - wall;
+  std::vector<GeometryNormalField> fields = geometry_normal_fields(scene, plan);
+  ASSERT_EQ(fields.size(), 2u);  // the block (deformable) and the wall (rigid)
+  const std::size_t w = fields[0].rigid_material >= 0 ? 0 : 1;
+  const int wall = fields[w].field, block = fields[1 - w].field;
+  move_rigid_shapes(fields, scene, 0.5);          // the disk's centre is at (1.5, -0.5)
+  BodyMotion& slid = fields[1 - w].motion.at(0);  // the block [-7, -6] x [5, 6] moved by (8, -7)
+  slid.C0 = {-6.5, 5.5, 0};
+  slid.c = {1.5, -1.5, 0};
 
   GridView<2, double> grid;
   grid.nodes_per_dim = {9, 9, 1};
@@ -219,22 +270,25 @@ radius = 2.0
     for (int f = 0; f < 2; ++f) gx[grid.at(f, i)] = 0.3, gy[grid.at(f, i)] = 0.4;
   gx[grid.at(wall, 44)] = gy[grid.at(wall, 44)] = 0.0;
 
-  const double t = 0.5;  // the disk's centre is at (1.5, -0.5)
-  orient_rigid_gradients(grid, nodes, surfaces, scene, t);
+  orient_gradients(grid, nodes, fields, {}, 0.5);  // no pair: each field its own normal
   for (std::uint32_t i : nodes) {
     const auto x = grid.position(i);
     const double rx = x[0] - 1.5, ry = x[1] + 0.5, r = std::hypot(rx, ry);
-    const std::size_t w = grid.at(wall, i), b = grid.at(block, i);
+    const std::size_t at = grid.at(wall, i);
     if (i == 44) {
-      EXPECT_EQ(gx[w], 0.0);
-      EXPECT_EQ(gy[w], 0.0);
+      EXPECT_EQ(gx[at], 0.0);
+      EXPECT_EQ(gy[at], 0.0);
     } else {
-      EXPECT_NEAR(gx[w], 0.5 * rx / r, kTol) << "node " << i;  // |g| = 0.5 kept
-      EXPECT_NEAR(gy[w], 0.5 * ry / r, kTol) << "node " << i;
+      EXPECT_NEAR(gx[at], 0.5 * rx / r, kTol) << "node " << i;  // |g| = 0.5 kept
+      EXPECT_NEAR(gy[at], 0.5 * ry / r, kTol) << "node " << i;
     }
-    EXPECT_EQ(gx[b], 0.3);
-    EXPECT_EQ(gy[b], 0.4);
   }
+  // The block, now [1, 2] x [-2, -1]: node 10 at (0.5, -3.5) lies below
+  // its bottom-left corner (1, -2), node 40 at (2, -2) on its corner.
+  const double c = 0.5 / std::hypot(0.5, 1.5);
+  EXPECT_NEAR(gx[grid.at(block, 10)], -0.5 * c, kTol);
+  EXPECT_NEAR(gy[grid.at(block, 10)], -0.5 * 3 * c, kTol);
+  EXPECT_NEAR(gx[grid.at(block, 70)], 0.5 * 1.5 / std::hypot(1.5, 0.5), kTol);
 }
 
 }  // namespace

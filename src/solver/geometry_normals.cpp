@@ -1,0 +1,89 @@
+#include "solver/geometry_normals.hpp"
+
+#include <cmath>
+
+#include "model/material.hpp"
+
+namespace mmpm {
+
+std::vector<GeometryNormalField> geometry_normal_fields(const Scene& scene, const FieldPlan& plan) {
+  std::vector<GeometryNormalField> out;
+  const auto F = std::size_t(plan.fields);
+  for (std::size_t f = 0; f < F; ++f) {
+    bool read = false;
+    for (std::size_t o = 0; o < F; ++o) {
+      const int l = plan.pair[f * F + o];
+      read |= o != f && l >= 0 && plan.laws[std::size_t(l)].normal == NormalMethod::geometry;
+    }
+    if (!read) continue;
+    GeometryNormalField g{int(f),
+                          plan.rigid[f] ? plan.rigid_material[f] : -1,
+                          ShapeSurface(scene, materials_in_field(plan, int(f))),
+                          {}};
+    g.motion.resize(g.surface.bodies().size());
+    out.push_back(std::move(g));
+  }
+  return out;
+}
+
+void move_rigid_shapes(std::vector<GeometryNormalField>& fields, const Scene& scene, double time) {
+  for (GeometryNormalField& f : fields) {
+    if (f.rigid_material < 0) continue;
+    // The particles moved with the material; the shapes are where they started.
+    const Vec3 u = rigid_displacement(scene.materials[std::size_t(f.rigid_material)], time);
+    for (BodyMotion& m : f.motion) m.c = u, m.C0 = {0, 0, 0};
+  }
+}
+
+std::vector<std::array<std::size_t, 2>> geometry_normal_pairs(
+    const std::vector<GeometryNormalField>& fields, const FieldPlan& plan) {
+  std::vector<std::array<std::size_t, 2>> out;
+  const auto F = std::size_t(plan.fields);
+  for (std::size_t a = 0; a < fields.size(); ++a)
+    for (std::size_t b = a + 1; b < fields.size(); ++b) {
+      const int l = plan.pair[std::size_t(fields[a].field) * F + std::size_t(fields[b].field)];
+      if (l >= 0 && plan.laws[std::size_t(l)].normal == NormalMethod::geometry)
+        out.push_back({a, b});
+    }
+  return out;
+}
+
+FaceNormal face_normal(const GeometryNormalField& f, const Vec3& x, double step, int dim) {
+  FaceNormal out;
+  out.n = f.surface.distance(x, &f.motion).gradient;
+  if (out.n[0] == 0 && out.n[1] == 0 && out.n[2] == 0) return out;
+  // Tangents of the face: in 3D two, from the axis least along n.
+  std::array<Vec3, 2> t{};
+  int tangents = 1;
+  if (dim == 2) {
+    t[0] = {-out.n[1], out.n[0], 0};
+  } else {
+    int axis = 0;
+    for (int d = 1; d < 3; ++d)
+      if (std::abs(out.n[d]) < std::abs(out.n[axis])) axis = d;
+    Vec3 e{0, 0, 0};
+    e[axis] = 1;
+    t[0] = {out.n[1] * e[2] - out.n[2] * e[1], out.n[2] * e[0] - out.n[0] * e[2],
+            out.n[0] * e[1] - out.n[1] * e[0]};
+    const double l = std::sqrt(t[0][0] * t[0][0] + t[0][1] * t[0][1] + t[0][2] * t[0][2]);
+    for (double& c : t[0]) c /= l;
+    t[1] = {out.n[1] * t[0][2] - out.n[2] * t[0][1], out.n[2] * t[0][0] - out.n[0] * t[0][2],
+            out.n[0] * t[0][1] - out.n[1] * t[0][0]};
+    tangents = 2;
+  }
+  const double cos30 = std::sqrt(3.0) / 2;
+  out.flat = true;
+  for (int k = 0; k < tangents && out.flat; ++k)
+    for (const double side : {-step, step}) {
+      Vec3 probe = x;
+      for (int d = 0; d < 3; ++d) probe[d] += side * t[std::size_t(k)][d];
+      const Vec3 m = f.surface.distance(probe, &f.motion).gradient;
+      if (m[0] * out.n[0] + m[1] * out.n[1] + m[2] * out.n[2] < cos30) {
+        out.flat = false;
+        break;
+      }
+    }
+  return out;
+}
+
+}  // namespace mmpm
