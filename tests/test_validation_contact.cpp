@@ -697,18 +697,22 @@ TEST(ValidationContact, DiskSlidesWhenFrictionIsLow) {
 // 4 x 1.5 mm, E = 1000 MPa, mu = 0.15 (inputs/rotated_incline.toml).
 // Down-slope acceleration of the block's centre of mass, fitted over
 // 0.07-0.2 ms.
-double rotated_incline_accel(const std::vector<std::string>& overrides) {
-  auto sim = make_simulation(parse_scene_file(input("rotated_incline.toml"), overrides));
+double down_slope_accel(Simulation& sim) {
   const double th = 20.0 * std::numbers::pi / 180.0;
   std::vector<double> t, v;
-  while (sim->time() < 0.2 - 1e-9 * sim->dt()) {
-    sim->step();
-    if (sim->time() < 0.07) continue;
-    const BodyState b = body_states(*sim, 2)[0];
-    t.push_back(sim->time());
+  while (sim.time() < 0.2 - 1e-9 * sim.dt()) {
+    sim.step();
+    if (sim.time() < 0.07) continue;
+    const BodyState b = body_states(sim, 2)[0];
+    t.push_back(sim.time());
     v.push_back(-(b.vx * std::cos(th) + b.vy * std::sin(th)));  // down the slope
   }
   return slope(t, v);
+}
+
+double rotated_incline_accel(const std::vector<std::string>& overrides) {
+  return down_slope_accel(
+      *make_simulation(parse_scene_file(input("rotated_incline.toml"), overrides)));
 }
 
 // With the slope's normal given (normal = "specified"), contact on the
@@ -770,17 +774,8 @@ std::string rotated_incline_on_an_elastic_floor() {
 }
 
 double elastic_floor_accel(const std::vector<std::string>& overrides) {
-  const double th = 20.0 * std::numbers::pi / 180.0;
-  auto sim = testing::make_from_text(rotated_incline_on_an_elastic_floor(), overrides);
-  std::vector<double> t, v;
-  while (sim->time() < 0.2 - 1e-9 * sim->dt()) {
-    sim->step();
-    if (sim->time() < 0.07) continue;
-    const BodyState b = body_states(*sim, 2)[0];
-    t.push_back(sim->time());
-    v.push_back(-(b.vx * std::cos(th) + b.vy * std::sin(th)));
-  }
-  return slope(t, v);
+  return down_slope_accel(
+      *testing::make_from_text(rotated_incline_on_an_elastic_floor(), overrides));
 }
 
 TEST(ValidationContact, RotatedInclineOnAnElasticFloorWithGeometryNormal) {
