@@ -46,7 +46,7 @@ template <int D, class Real>
 void fit_body_motions(std::vector<GeometryNormalField>& fields, const ParticleView<D, Real>& P,
                       const std::uint32_t* id, std::size_t n, const std::vector<int>& body_of_id,
                       std::size_t scene_bodies) {
-  // slot[field * bodies + body]: that body's moments, or none.
+  // Each geometry field's entry, and each of its bodies' moments (-1: none).
   std::vector<int> field_slot(256, -1);
   std::vector<int> body_slot(scene_bodies, -1);
   std::vector<BodyMoments> moments;
