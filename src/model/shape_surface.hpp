@@ -61,7 +61,8 @@ class ShapeSurface {
  public:
   // The region the bodies of `materials` fill: each body less the later
   // bodies of other materials, which took their own volume out of it, as
-  // they took its particles (model/bodies.hpp).
+  // they took its particles (model/bodies.hpp). It points into
+  // scene.bodies, which must outlive it.
   ShapeSurface(const Scene& scene, const std::vector<std::size_t>& materials);
 
   // Scene indices of the bodies that fill it, in scene order.

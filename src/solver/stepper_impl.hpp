@@ -36,7 +36,8 @@ Stepper<D, Shape, Real>::Stepper(const Scene& scene) : scene_(scene), plan_(plan
   }
   domain_gradient_ = plan_.multimaterial && needs_domain_gradient(plan_);
   setup_grid();
-  geometry_fields_ = geometry_normal_fields(scene, plan_);
+  // From the stepper's own copy of the scene: the shapes point into its bodies.
+  geometry_fields_ = geometry_normal_fields(scene_, plan_);
   geometry_pairs_ = geometry_normal_pairs(geometry_fields_, plan_);
   setup_particles(make_particles(scene));
   setup_mirrors();
