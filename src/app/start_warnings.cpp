@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <sstream>
 
 #include "kernels/shape.hpp"
+#include "model/bodies.hpp"
 #include "scene/format.hpp"
 #include "scene/interaction_warning.hpp"
 #include "scene/unused_keys.hpp"
@@ -142,12 +142,12 @@ bool has_slanted_face(const BodySpec& b) {
   const double turn = std::remainder(b.rotate, 90.0);
   if (b.shape == BodyShape::box) return turn != 0.0;
   if (b.shape != BodyShape::polygon) return false;
-  const double a = b.rotate * std::numbers::pi / 180.0;
+  const BodyFrame frame(b);
   for (std::size_t i = 0, j = b.points.size() - 1; i < b.points.size(); j = i++) {
-    const double ex = b.points[i][0] - b.points[j][0], ey = b.points[i][1] - b.points[j][1];
-    const double dx = std::cos(a) * ex - std::sin(a) * ey, dy = std::sin(a) * ex + std::cos(a) * ey;
-    const double tol = 1e-9 * std::hypot(dx, dy);
-    if (std::abs(dx) > tol && std::abs(dy) > tol) return true;
+    const Vec3 e =
+        frame.to_global({b.points[i][0] - b.points[j][0], b.points[i][1] - b.points[j][1], 0.0});
+    const double tol = 1e-9 * std::hypot(e[0], e[1]);
+    if (std::abs(e[0]) > tol && std::abs(e[1]) > tol) return true;
   }
   return false;
 }

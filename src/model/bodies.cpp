@@ -112,10 +112,6 @@ class SeedCells {
 
 }  // namespace
 
-Vec3 rotation_centre(const BodySpec& b) {
-  return box_center(b);
-}
-
 std::pair<Vec3, Vec3> shape_bounds(const BodySpec& b, int dimension) {
   BodySpec shape = b;
   shape.clip.reset();
@@ -131,20 +127,20 @@ bool inside_polygon(const std::vector<Vec3>& pts, double x, double y) {
   return in;
 }
 
-// Global → body frame for a box rotated by `rotate` degrees about its centre (2D).
-Vec3 to_body_frame(const BodySpec& b, const Vec3& x) {
-  if (b.rotate == 0.0) return x;
-  const Vec3 c = box_center(b);
-  const double a = -b.rotate * std::numbers::pi / 180.0;
-  const double dx = x[0] - c[0], dy = x[1] - c[1];
-  return {c[0] + std::cos(a) * dx - std::sin(a) * dy, c[1] + std::sin(a) * dx + std::cos(a) * dy,
-          x[2]};
+BodyFrame::BodyFrame(const BodySpec& b) : turned(b.rotate != 0.0), origin(box_center(b)) {
+  const double a = b.rotate * std::numbers::pi / 180.0;
+  cos_a = std::cos(a), sin_a = std::sin(a);
 }
 
-Vec3 rotate_vector(const BodySpec& b, const Vec3& v) {
-  if (b.rotate == 0.0) return v;
-  const double a = b.rotate * std::numbers::pi / 180.0;
-  return {std::cos(a) * v[0] - std::sin(a) * v[1], std::sin(a) * v[0] + std::cos(a) * v[1], v[2]};
+Vec3 BodyFrame::to_body(const Vec3& x) const {
+  if (!turned) return x;
+  const double dx = x[0] - origin[0], dy = x[1] - origin[1];
+  return {origin[0] + cos_a * dx + sin_a * dy, origin[1] - sin_a * dx + cos_a * dy, x[2]};
+}
+
+Vec3 BodyFrame::to_global(const Vec3& v) const {
+  if (!turned) return v;
+  return {cos_a * v[0] - sin_a * v[1], sin_a * v[0] + cos_a * v[1], v[2]};
 }
 
 bool inside_body(const BodySpec& b, const Vec3& x, int dim) {
@@ -154,7 +150,7 @@ bool inside_body(const BodySpec& b, const Vec3& x, int dim) {
   }
   switch (b.shape) {
     case BodyShape::box: {
-      const Vec3 u = to_body_frame(b, x);
+      const Vec3 u = BodyFrame(b).to_body(x);
       for (int d = 0; d < dim; ++d)
         if (u[d] < b.min[d] || u[d] > b.max[d]) return false;
       return true;
@@ -168,7 +164,7 @@ bool inside_body(const BodySpec& b, const Vec3& x, int dim) {
     case BodyShape::cylinder:
       return inside_cylinder(b, x);
     case BodyShape::polygon: {
-      const Vec3 u = to_body_frame(b, x);
+      const Vec3 u = BodyFrame(b).to_body(x);
       return inside_polygon(b.points, u[0], u[1]);
     }
   }
@@ -268,17 +264,18 @@ ParticleSeeds make_particles(const Scene& scene) {
       throw InputError(located(load.where.file, load.where.line, load.where.key + ".where",
                                "traction loads act on box bodies only"));
     const int ax = load.face_axis;
+    const BodyFrame frame(body);
     const double spacing = scene.grid.cell[std::size_t(ax)] / body.particles_per_cell;
     double extreme = load.face_max ? -1e300 : 1e300;
     for (std::size_t p = 0; p < w; ++p) {
       if (out.body[p] != bi) continue;
-      const double u = to_body_frame(body, out.x[p])[std::size_t(ax)];
+      const double u = frame.to_body(out.x[p])[std::size_t(ax)];
       extreme = load.face_max ? std::max(extreme, u) : std::min(extreme, u);
     }
     std::vector<std::size_t> face;
     for (std::size_t p = 0; p < w; ++p) {
       if (out.body[p] != bi) continue;
-      const double u = to_body_frame(body, out.x[p])[std::size_t(ax)];
+      const double u = frame.to_body(out.x[p])[std::size_t(ax)];
       if (std::abs(u - extreme) < 0.5 * spacing) face.push_back(p);
     }
     // A body the later bodies replaced everywhere (allowed: an inclusion
@@ -293,13 +290,13 @@ ParticleSeeds make_particles(const Scene& scene) {
     double area = dim == 2 ? scene.simulation.thickness : 1.0;
     for (int d = 0; d < dim; ++d)
       if (d != ax) area *= body.max[d] - body.min[d];
-    const Vec3 t = rotate_vector(body, load.traction);
+    const Vec3 t = frame.to_global(load.traction);
     // The face's outward normal, and the distance from a particle to the
     // edge of its (grid-aligned) domain along it: the half-width on an
     // unrotated face, to the domain's boundary on a rotated one.
     Vec3 normal{0, 0, 0};
     normal[std::size_t(ax)] = load.face_max ? 1.0 : -1.0;
-    normal = rotate_vector(body, normal);
+    normal = frame.to_global(normal);
     double reach = 1e300;
     bool grid_aligned = false;
     for (int d = 0; d < dim; ++d) grid_aligned = grid_aligned || std::abs(normal[d]) > 1 - 1e-12;
@@ -319,7 +316,7 @@ ParticleSeeds make_particles(const Scene& scene) {
       // different depths below the face; each load acts on the face itself,
       // not past the particle's domain (a bar at 30 degrees, loaded at both
       // ends: end stress 0.97 t, 1.07 with every load at the domain's edge).
-      const double u = to_body_frame(body, out.x[p])[std::size_t(ax)];
+      const double u = frame.to_body(out.x[p])[std::size_t(ax)];
       const double depth = load.face_max ? body.max[ax] - u : u - body.min[ax];
       const double along = grid_aligned ? reach : std::clamp(depth, 0.0, reach);
       for (int d = 0; d < dim; ++d) {

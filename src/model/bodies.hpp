@@ -29,13 +29,17 @@ struct ParticleSeeds {
 // no particle on its face.
 ParticleSeeds make_particles(const Scene& scene);
 
-// Global → body frame for a body turned by `rotate` degrees about its
-// pivot (2D; the identity when rotate = 0), and a vector turned back.
-Vec3 to_body_frame(const BodySpec& b, const Vec3& x);
-Vec3 rotate_vector(const BodySpec& b, const Vec3& v);
-
-// The point a body turns about by `rotate`: its pivot, or its centre.
-Vec3 rotation_centre(const BodySpec& b);
+// A body's turn by `rotate` degrees about its pivot, or its centre (2D; the
+// identity when rotate = 0), its sine and cosine computed once: global →
+// body frame for points, body → global for vectors.
+struct BodyFrame {
+  explicit BodyFrame(const BodySpec& b);
+  Vec3 to_body(const Vec3& x) const;
+  Vec3 to_global(const Vec3& v) const;
+  bool turned = false;
+  double cos_a = 1, sin_a = 0;
+  Vec3 origin{0, 0, 0};
+};
 
 // The bounding box of a body's shape, its clip box left out.
 std::pair<Vec3, Vec3> shape_bounds(const BodySpec& b, int dimension);

@@ -117,22 +117,6 @@ SurfaceDistance shape_distance(const BodySpec& b, const BodyFrame& frame, const 
 
 }  // namespace
 
-BodyFrame::BodyFrame(const BodySpec& b) : turned(b.rotate != 0.0), origin(rotation_centre(b)) {
-  const double a = b.rotate * std::numbers::pi / 180.0;
-  cos_a = std::cos(a), sin_a = std::sin(a);
-}
-
-Vec3 BodyFrame::to_body(const Vec3& x) const {  // as model/bodies' to_body_frame
-  if (!turned) return x;
-  const double dx = x[0] - origin[0], dy = x[1] - origin[1];
-  return {origin[0] + cos_a * dx + sin_a * dy, origin[1] - sin_a * dx + cos_a * dy, x[2]};
-}
-
-Vec3 BodyFrame::to_global(const Vec3& v) const {  // as rotate_vector
-  if (!turned) return v;
-  return {cos_a * v[0] - sin_a * v[1], sin_a * v[0] + cos_a * v[1], v[2]};
-}
-
 SurfaceDistance body_distance(const BodySpec& body, const Vec3& x, int dim) {
   return body_distance(body, BodyFrame(body), x, dim);
 }

@@ -12,6 +12,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "model/bodies.hpp"
 #include "scene/scene.hpp"
 
 namespace mmpm {
@@ -21,17 +22,6 @@ namespace mmpm {
 struct SurfaceDistance {
   double distance = 0;
   Vec3 gradient{0, 0, 0};
-};
-
-// A body's turn by `rotate` about its centre (2D), its sine and cosine
-// computed once.
-struct BodyFrame {
-  explicit BodyFrame(const BodySpec& b);
-  Vec3 to_body(const Vec3& x) const;
-  Vec3 to_global(const Vec3& v) const;
-  bool turned = false;
-  double cos_a = 1, sin_a = 0;
-  Vec3 origin{0, 0, 0};
 };
 
 // One body's shape, its clip box included, in global coordinates.

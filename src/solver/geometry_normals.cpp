@@ -52,21 +52,16 @@ FaceNormal face_normal(const GeometryNormalField& f, const Vec3& x, double step,
   FaceNormal out;
   out.n = f.surface.distance(x, &f.motion).gradient;
   if (out.n[0] == 0 && out.n[1] == 0 && out.n[2] == 0) return out;
-  // Tangents of the face: in 3D two, from the axis least along n.
+  // Tangents of the face: the interface's fixed perpendicular of n
+  // (kernels/mm_normals.hpp), and in 3D n × it.
   std::array<Vec3, 2> t{};
   int tangents = 1;
   if (dim == 2) {
-    t[0] = {-out.n[1], out.n[0], 0};
+    const VecD<2, double> t2 =
+        tangent_or_perpendicular<2, double>({0, 0}, 0.0, {out.n[0], out.n[1]});
+    t[0] = {t2[0], t2[1], 0};
   } else {
-    int axis = 0;
-    for (int d = 1; d < 3; ++d)
-      if (std::abs(out.n[d]) < std::abs(out.n[axis])) axis = d;
-    Vec3 e{0, 0, 0};
-    e[axis] = 1;
-    t[0] = {out.n[1] * e[2] - out.n[2] * e[1], out.n[2] * e[0] - out.n[0] * e[2],
-            out.n[0] * e[1] - out.n[1] * e[0]};
-    const double l = std::sqrt(t[0][0] * t[0][0] + t[0][1] * t[0][1] + t[0][2] * t[0][2]);
-    for (double& c : t[0]) c /= l;
+    t[0] = tangent_or_perpendicular<3, double>({0, 0, 0}, 0.0, out.n);
     t[1] = {out.n[1] * t[0][2] - out.n[2] * t[0][1], out.n[2] * t[0][0] - out.n[0] * t[0][2],
             out.n[0] * t[0][1] - out.n[1] * t[0][0]};
     tangents = 2;
