@@ -518,4 +518,23 @@ TEST(Restart, KilledBSplineRunWithAMirrorContinuesBitwise) {
   check_killed_run_continues_bitwise(scene);
 }
 
+// With normal = "geometry" on bodies turned by 10 degrees: each step fits
+// every body's rotation and translation from its particles' seeded and
+// current positions (solver/geometry_normals.hpp), so a restart that lost
+// the seeded positions, or numbered the particles' bodies otherwise,
+// would turn the interface's normals and differ in the bits.
+TEST(Restart, KilledGeometryNormalRunContinuesBitwise) {
+  std::string scene = kScene;
+  const auto swap = [&](const std::string& from, const std::string& to) {
+    const auto at = scene.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    scene.replace(at, from.size(), to);
+  };
+  const std::string turned = "rotate = 10.0\npivot = [22.0, 13.0]\n";
+  swap("velocity = [0.0, 2.0]\n", "velocity = [0.0, 2.0]\n" + turned);
+  swap("velocity = [0.0, -2.0]\n", "velocity = [0.0, -2.0]\n" + turned);
+  swap("normal = \"specified\"\nnormal_vector = [1.0, 0.0]\n", "normal = \"geometry\"\n");
+  check_killed_run_continues_bitwise(scene);
+}
+
 }  // namespace
