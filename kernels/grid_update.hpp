@@ -30,52 +30,14 @@ struct GridUpdateParams {
   // same pass: for steps where nothing changes p in between (no
   // multimaterial pass B). Bitwise the two separate passes.
   bool velocities = false;
-  // USL only (0 otherwise): at nodes whose mass is at most this, vel leaves
-  // out the force increment (light_node_velocity below).
-  double light_threshold = 0;
+  // USL only (nullptr otherwise), per field: the light-node mass m_L (see
+  // update_deformable's light nodes below).
+  const double* light_threshold = nullptr;
   // With velocities: false when nothing reads p after this pass (the
   // single-field step: G2P reads vel and dvel, MUSL zeroes p for its second
   // scatter, the next step's P2G starts from zero), so the updated momentum
   // is not stored: 3 of the 3D pass's 16 arrays (2 of 11 in 2D).
   bool keep_momentum = true;
-};
-
-// USL's velocity gradient reads the grid velocity after the momentum
-// update, v = (p + dt (f + m g - alpha p)) / m. At a node that a particle
-// barely reaches, m ~ S m_p while the force f, made of the weight gradient
-// G, does not vanish with S (G ~ sqrt(S) at a uGIMP support edge, 1/h for
-// linear shapes): the particle's strain rate takes G dt f / m, which grows
-// without bound as S -> 0 (USL's small-mass instability). The two-layer
-// scene in float went unstable this way (J <= 0 at step 202 and, with that
-// node alone fixed, at step 303). MUSL and USF read p / m of extrapolated
-// momenta (weighted means of particle velocities) and have no such term.
-// So at a light node USL's gradient and positions use the velocity without
-// the force increment, v_old + dt (g - alpha v_old) (gravity and damping
-// stay: they are per unit mass, bounded); the FLIP increment dvel, which
-// the particles take scaled by S, keeps the force. docs/validation.md §3.5.
-template <class Real>
-[[gnu::always_inline]] inline Real light_node_velocity(Real v_old, Real dt, Real alpha, Real g) {
-  return std::fma(dt, std::fma(-alpha, v_old, g), v_old);
-}
-
-// USL's light nodes for grid_velocities: threshold 0 (MUSL, USF): none.
-template <int D, class Real>
-struct LightNodes {
-  Real threshold = 0;  // a node of mass <= threshold (and above the sliver threshold) is light
-  Real dt = 0, alpha = 0;
-  Real gacc[D] = {};
-  const unsigned char* rigid = nullptr;  // per field: prescribed velocities are left alone
-
-  // The same light nodes as grid_update's with these parameters.
-  static LightNodes of(const GridUpdateParams& q) {
-    LightNodes l;
-    l.threshold = Real(q.light_threshold);
-    l.dt = Real(q.dt);
-    l.alpha = Real(q.damping);
-    for (int d = 0; d < D; ++d) l.gacc[d] = Real(q.body_accel[d]);
-    l.rigid = q.rigid;
-    return l;
-  }
 };
 
 namespace detail {
@@ -97,6 +59,7 @@ template <int D, class Real, bool Interface, bool Damping, bool Velocities, bool
                                          std::size_t o, std::size_t b, std::size_t e, Real dt,
                                          Real alpha, Real thr, Real light, const Real (&gacc)[D],
                                          double* __restrict pv) {
+  const Real inv_light = light > Real(0) ? Real(1) / light : Real(0);
   const Real* __restrict m_ = G.m + o;
   Real* __restrict p_[D];
   const Real* __restrict f_[D];
@@ -121,6 +84,22 @@ template <int D, class Real, bool Interface, bool Damping, bool Velocities, bool
     // surface. m = 0 gives 0/0 here, which the select drops.
     const bool some = m > Real(0);
     const Real inv_m = Real(1) / m;
+    // USL's light nodes (m <= m_L, USL only). USL's velocity gradient reads
+    // the grid velocity after the momentum update, v = (p + dt (f + m g -
+    // alpha p)) / m. At a node that a particle barely reaches, m ~ S m_p
+    // while the force f, made of the weight gradient, does not vanish with
+    // S (~sqrt(S) at a uGIMP support edge, 1/h for linear shapes): the
+    // particle's strain rate takes dt f / m times the gradient, a feedback
+    // on its own strain of (c dt / h)^2 m_p / m that flips sign every step
+    // (USL's small-mass instability; docs/validation.md §3.5). There the
+    // momentum takes the force as if the node held m_L: f m / m_L, so the
+    // feedback is bounded by (c dt / h)^2 m_p / m_L. What the node leaves
+    // out, dt f (1 / m - 1 / m_L), still reaches the particles through the
+    // FLIP increment dvel (scaled by S): momentum is kept to round-off, and
+    // the multimaterial pass B, which runs between this pass and the
+    // velocities, sees momenta whose velocities are bounded. MUSL and USF
+    // (m_L = 0) read p / m of re-extrapolated momenta and have no such term.
+    const Real keep = m <= light ? m * inv_light : Real(1);
     double sum = 0;
     // Unrolled completely: with USL's light-node select the body grew past
     // GCC's complete-unroll limit in 3D, the n loop then held a loop over d,
@@ -134,18 +113,19 @@ template <int D, class Real, bool Interface, bool Damping, bool Velocities, bool
       // remainder, so a node's bits depended on where a thread's range
       // began (tests/test_node_ownership.cpp caught it).
       Real force = std::fma(m, gacc[d], f_[d][n]);
-      Real damped = std::fma(-alpha, p, force);
+      Real damped = std::fma(-alpha, p, std::fma(m, gacc[d], f_[d][n] * keep));
       if constexpr (Interface) force += fi_[d][n], damped += fi_[d][n];
       const Real sliver = some ? dt * force / m : Real(0);
       const Real updated = std::fma(dt, damped, p);
+      // The light node's force left out of the momentum, for dvel: 0 elsewhere.
+      const Real left_out = dt * f_[d][n] * (Real(1) - keep) * inv_m;
       if constexpr (Velocities) {
         // grid_velocities' formulas on the updated momentum.
-        const Real v_old = p * inv_m;
-        const Real v_light = light_node_velocity(v_old, dt, alpha, gacc[d]);
-        vel_[d][n] = heavy ? (m <= light ? v_light : updated * inv_m) : Real(0);
-        dv_[d][n] = heavy ? std::fma(updated, inv_m, -p * inv_m) : sliver;
+        vel_[d][n] = heavy ? updated * inv_m : Real(0);
+        const Real dv = std::fma(updated, inv_m, -p * inv_m);
+        dv_[d][n] = heavy ? (m <= light ? dv + left_out : dv) : sliver;
       } else {
-        dv_[d][n] = heavy ? -p * inv_m : sliver;
+        dv_[d][n] = heavy ? (m <= light ? left_out - p * inv_m : -p * inv_m) : sliver;
       }
       if constexpr (KeepP) p_[d][n] = heavy ? updated : p;
       sum = std::fma(double(p) * double(p), double(inv_m), sum);
@@ -165,10 +145,10 @@ template <int D, class Real, bool Interface, bool Damping, bool Velocities, bool
 template <int D, class Real, class After = NoNodeHook>
 double grid_update(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
                    const GridUpdateParams& q, const NodeOwnership& own = {}, After&& after = {}) {
-  const Real dt = Real(q.dt), alpha = Real(q.damping), thr = Real(q.mass_threshold),
-             light = Real(q.light_threshold);
+  const Real dt = Real(q.dt), alpha = Real(q.damping), thr = Real(q.mass_threshold);
   auto body = [&](int f, std::size_t b, std::size_t e, std::array<double, 1>& acc) {
     const std::size_t o = std::size_t(f) * G.nodes;
+    const Real light = q.light_threshold ? Real(q.light_threshold[std::size_t(f)]) : Real(0);
     if (q.rigid && q.rigid[f]) {
       // Prescribed motion (ALGORITHM §7): p = m v_rigid; no force, no loss.
       for (std::size_t n = b; n < e; ++n) {
@@ -253,50 +233,52 @@ double grid_update(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
 namespace detail {
 
 // The node loop of grid_velocities (CompleteDvel) and
-// grid_momentum_velocities: selects instead of a branch per node, through
-// restrict pointers, so the compiler vectorises it (the branchy loops ran
-// scalar). Every node computes its quotient (m = 0 gives 0/0 or inf, which
-// the select drops).
-template <bool CompleteDvel, int D, class Real, class After>
-void node_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V, Real thr,
-                     const LightNodes<D, Real>& ln, const NodeOwnership& own, After& after) {
-  // The ranges' loop is a function of its own, as it was the body of an
-  // OpenMP region (its restrict locals keep it vectorised).
-  const auto ranges = [&](int f, std::size_t first, std::size_t last) {
-    const std::size_t o = std::size_t(f) * G.nodes;
-    // Locals, not reads through `ln` in the loop: the stores to vel_ and
-    // dv_ could alias them, and the loop then stayed scalar
-    // (tools/check_vectorised.py).
-    const Real light = ln.rigid && ln.rigid[f] ? Real(0) : ln.threshold;
-    const Real light_dt = ln.dt, light_alpha = ln.alpha;
-    Real light_g[D];
-    for (int d = 0; d < D; ++d) light_g[d] = ln.gacc[d];
-    const Real* __restrict m_ = G.m;
-    const Real* __restrict p_[D];
-    Real* __restrict vel_[D];
-    Real* __restrict dv_[D];
-    for (int d = 0; d < D; ++d) p_[d] = G.p[d], vel_[d] = V.vel[d], dv_[d] = V.dvel[d];
+// grid_momentum_velocities on one range [first, last) of a field's nodes:
+// selects instead of a branch per node, through restrict pointers, so the
+// compiler vectorises it (the branchy loops ran scalar). Every node
+// computes its quotient (m = 0 gives 0/0 or inf, which the select drops).
+// noinline: inlined, the loop moved between the team's region body and
+// for_own_field_nodes' copy as its body changed, and
+// tools/check_vectorised.py must find it; out of line it vectorises in
+// every unit, as update_deformable does.
+template <bool CompleteDvel, int D, class Real>
+[[gnu::noinline]] void velocity_range(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
+                                      Real thr, std::size_t first, std::size_t last) {
+  const Real* __restrict m_ = G.m;
+  const Real* __restrict p_[D];
+  Real* __restrict vel_[D];
+  Real* __restrict dv_[D];
+  for (int d = 0; d < D; ++d) p_[d] = G.p[d], vel_[d] = V.vel[d], dv_[d] = V.dvel[d];
 #pragma GCC ivdep
-    for (std::size_t i = o + first; i < o + last; ++i) {
-      const Real m = m_[i];
-      const bool heavy = m > thr;
-      if constexpr (CompleteDvel) {
-        const Real inv_m = Real(1) / m;
-        for (int d = 0; d < D; ++d) {
-          // dvel + p/m as an explicit fma (see update_deformable).
-          // dv_ holds -v_old (grid_update).
-          const Real v = p_[d][i] * inv_m, dv = std::fma(p_[d][i], inv_m, dv_[d][i]);
-          const Real v_light = light_node_velocity(-dv_[d][i], light_dt, light_alpha, light_g[d]);
-          vel_[d][i] = heavy ? (m <= light ? v_light : v) : Real(0);
-          dv_[d][i] = heavy ? dv : dv_[d][i];  // slivers: set by grid_update
-        }
-      } else {
-        for (int d = 0; d < D; ++d) {
-          const Real v = p_[d][i] / m;
-          vel_[d][i] = heavy ? v : Real(0);
-        }
+  for (std::size_t i = first; i < last; ++i) {
+    const Real m = m_[i];
+    const bool heavy = m > thr;
+    if constexpr (CompleteDvel) {
+      const Real inv_m = Real(1) / m;
+#pragma GCC unroll 3
+      for (int d = 0; d < D; ++d) {
+        // dvel + p/m as an explicit fma (see update_deformable).
+        // dv_ holds -v_old (grid_update), plus a light node's left-out force.
+        const Real v = p_[d][i] * inv_m, dv = std::fma(p_[d][i], inv_m, dv_[d][i]);
+        vel_[d][i] = heavy ? v : Real(0);
+        dv_[d][i] = heavy ? dv : dv_[d][i];  // slivers: set by grid_update
+      }
+    } else {
+#pragma GCC unroll 3
+      for (int d = 0; d < D; ++d) {
+        const Real v = p_[d][i] / m;
+        vel_[d][i] = heavy ? v : Real(0);
       }
     }
+  }
+}
+
+template <bool CompleteDvel, int D, class Real, class After>
+void node_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V, Real thr,
+                     const NodeOwnership& own, After& after) {
+  const auto ranges = [&](int f, std::size_t first, std::size_t last) {
+    const std::size_t o = std::size_t(f) * G.nodes;
+    velocity_range<CompleteDvel>(G, V, thr, o + first, o + last);
     after(f, first, last);
   };
   team_run(G.nodes * std::size_t(G.fields) >= kParallelMin,
@@ -307,13 +289,11 @@ void node_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
 
 // vel = p/m, dvel += vel (completing v_new - v_old), after pass B; nodes
 // with a sliver of mass keep vel = 0 and the increment grid_update gave them.
-// Then after(f, first, last) on each range, as grid_update. `light`: USL's
-// light nodes (light_node_velocity).
+// Then after(f, first, last) on each range, as grid_update.
 template <int D, class Real, class After = NoNodeHook>
 void grid_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V, Real thr,
-                     const NodeOwnership& own = {}, After&& after = {},
-                     const LightNodes<D, Real>& light = {}) {
-  detail::node_velocities<true>(G, V, thr, light, own, after);
+                     const NodeOwnership& own = {}, After&& after = {}) {
+  detail::node_velocities<true>(G, V, thr, own, after);
 }
 
 // vel = p/m alone (dvel untouched): the velocities of re-extrapolated
@@ -324,7 +304,7 @@ void grid_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
 template <int D, class Real, class After = NoNodeHook>
 void grid_momentum_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V, Real thr,
                               const NodeOwnership& own = {}, After&& after = {}) {
-  detail::node_velocities<false>(G, V, thr, LightNodes<D, Real>{}, own, after);
+  detail::node_velocities<false>(G, V, thr, own, after);
 }
 
 }  // namespace mmpm

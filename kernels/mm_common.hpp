@@ -20,7 +20,7 @@ using VecD = std::array<Real, D>;
 
 // ALGORITHM §4.3: at a node, a material field of at most this fraction of the
 // lightest particle's mass is a sliver, empty to contact and interfaces
-// (MultimaterialStage) and a light node to USL (Stepper::usl_light_threshold).
+// (MultimaterialStage) and a light node to USL (Stepper::set_usl_light_thresholds).
 inline constexpr double kSliverMassFraction = 1e-6;
 
 // A rigid partner whose nodal domain fills less than this fraction of a cell

@@ -37,10 +37,10 @@ RULES = [
     (r"^void mmpm::detail::update_deformable<", 16, None,
      "grid momentum update (kernels/grid_update.hpp)"),
     # A short loop: vel = m > thr ? p/m : 0 (and dvel) is 2-6 packed
-    # divides and fmas; as scalar code it has none. It is inlined into the
-    # region that runs it (kernels/team.hpp: the team's body and the
-    # OpenMP fallback's outlined copy).
-    (r"^void mmpm::team_run<mmpm::detail::node_velocities<", 2, None,
+    # divides and fmas; as scalar code it has none. Out of line since
+    # 2026-12-06: inlined, it moved between the team's region body and
+    # for_own_field_nodes' copy as the loop's body changed.
+    (r"^void mmpm::detail::velocity_range<", 2, None,
      "grid velocities (kernels/grid_update.hpp)"),
     # The per-material loops of one range: the constitutive pass's threads
     # and the fused step tail's tiles call it (solver/stepper_impl.hpp).

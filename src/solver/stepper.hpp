@@ -170,7 +170,7 @@ class Stepper final : public Simulation {
   void grid_update_stage();
   void update_node_ownership(bool rebuilt);
   void update_active_nodes();
-  Real usl_light_threshold() const;
+  void set_usl_light_thresholds(const ParticleSeeds& seeds);
   void finish_velocities(bool with_dvel);
   Supports<Real> supports(bool with_dvel);
   void add_rigid_work();
@@ -208,6 +208,7 @@ class Stepper final : public Simulation {
   Real thickness_ = 1;
   Real mass_threshold_ = 0;
   double min_particle_mass_ = 0;
+  std::vector<double> usl_light_threshold_;  // per field; empty: none (MUSL, USF)
   std::array<double, 3> gravity_{0, 0, 0};
   bool has_gravity_ = false, has_traction_ = false;
   bool domain_gradient_ = false;    // some interaction's normal needs g (P-33)

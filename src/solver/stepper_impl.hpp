@@ -226,6 +226,7 @@ void Stepper<D, Shape, Real>::setup_particles(const ParticleSeeds& seeds) {
   // pass keeps its own, larger threshold (MultimaterialStage::setup).
   mass_threshold_ = Real(1e-15 * min_mass);
   min_particle_mass_ = min_mass;
+  set_usl_light_thresholds(seeds);
   // Check every particle's stencil fits the grid before anything runs.
   const std::array<Real, 3> inv_h{Real(1) / G_.h[0], Real(1) / G_.h[1], Real(1) / G_.h[2]};
   Stencil<D, Shape, Real> st{};
@@ -844,7 +845,7 @@ GridUpdateParams Stepper<D, Shape, Real>::grid_update_params() const {
   q.rigid = plan_.rigid.data();
   q.rigid_velocity = reinterpret_cast<const double(*)[3]>(rigid_velocity_now_.data());
   q.has_interface_force = mm_.has_interface_forces();
-  q.light_threshold = double(usl_light_threshold());
+  q.light_threshold = usl_light_threshold_.empty() ? nullptr : usl_light_threshold_.data();
   return q;
 }
 
@@ -1046,14 +1047,36 @@ void Stepper<D, Shape, Real>::add_rigid_work() {
   }
 }
 
-// USL's light nodes (kernels/grid_update.hpp, light_node_velocity): a mass
-// of at most 1e-6 of the lightest particle, the threshold below which the
-// multimaterial pass already takes a field as empty (ALGORITHM §4.3); 0
-// (none) in MUSL and USF.
+// USL's light-node masses m_L (kernels/grid_update.hpp, update_deformable),
+// per field; none in MUSL and USF. Every shape: 1e-6 of the lightest
+// particle, the threshold below which the multimaterial pass already takes
+// a field as empty (ALGORITHM §4.3); uGIMP's and the B-splines' feedback
+// |grad S|^2 / S stays bounded as S -> 0 (docs/validation.md §3.5). Linear
+// shapes also: 2 m_p (c_p dt / h)^2 over the field's particles p, because
+// their feedback (c dt / h)^2 m_p / m grows without bound as a particle
+// enters a cell (|grad S| = 1 / h while S -> 0): USL with linear shapes
+// broke at every cell crossing (the incline block, the rolling disk and
+// the impact scenes stopped with J <= 0 by step 400 at cfl 0.5, a free bar
+// at every cfl from 0.55). With m_L the node's feedback is at most
+// (c dt / h)^2 m_p / m_L = 1/2 per particle that reaches it, summed over
+// them; the factor 2 is measured: at 1, the incline block and a block on a
+// slanted staircase still grew at cfl 0.7.
 template <int D, class Shape, class Real>
-Real Stepper<D, Shape, Real>::usl_light_threshold() const {
-  if (scene_.simulation.scheme != Scheme::USL) return Real(0);
-  return Real(min_particle_mass_) * Real(kSliverMassFraction);
+void Stepper<D, Shape, Real>::set_usl_light_thresholds(const ParticleSeeds& seeds) {
+  usl_light_threshold_.clear();
+  if (scene_.simulation.scheme != Scheme::USL) return;
+  usl_light_threshold_.assign(std::size_t(plan_.fields), min_particle_mass_ * kSliverMassFraction);
+  if constexpr (std::is_same_v<Shape, LinearShape>) {
+    double h = double(G_.h[0]);
+    for (int d = 1; d < D; ++d) h = std::min(h, double(G_.h[d]));
+    for (std::size_t p = 0; p < seeds.x.size(); ++p) {
+      const auto material = std::size_t(seeds.material[p]);
+      const double mass = materials_[material].density * seeds.volume[p];
+      const double courant = dt_ * materials_[material].wave_speed / h;
+      double& light = usl_light_threshold_[std::size_t(plan_.field_of_material[material])];
+      light = std::max(light, 2.0 * mass * courant * courant);
+    }
+  }
 }
 
 template <int D, class Shape, class Real>
@@ -1061,8 +1084,7 @@ void Stepper<D, Shape, Real>::finish_velocities(bool with_dvel) {
   const Supports<Real> s = supports(with_dvel);
   auto hook = [&](int f, std::size_t b, std::size_t e) { apply_supports(G_, GV_, s, f, b, e); };
   if (with_dvel) {
-    const auto light = LightNodes<D, Real>::of(grid_update_params());
-    grid_velocities(G_, GV_, mass_threshold_, own_, hook, light);
+    grid_velocities(G_, GV_, mass_threshold_, own_, hook);
     mirror_ghost_velocities(true);
     collect_support_reactions();
   } else {

@@ -87,7 +87,9 @@ double fastest_wave_speed(const Scene& scene) {
 // blowing up below the 0.75 measured before): uGIMP stable at 0.55, growing
 // at 0.6 on a support (2D and 3D) and at 0.65 free; quadratic B-splines
 // stable at 0.7, growing at 0.75 free; linear stable at 0.75 on a support
-// (free, it breaks at cell crossings at any step); cubic B-splines stable
+// and free (it broke at cell crossings at any step until USL's light-node
+// mass, 2026-12-06; a block on a slanted staircase grows at 0.75); cubic
+// B-splines stable
 // to 1.0. A warning, not a refusal: the limit is a measurement, and a scene
 // that ends within a few wave passes may finish before the mode grows; the
 // energy guard (app/energy_guard.hpp) stops one that does not.
