@@ -1055,12 +1055,13 @@ void Stepper<D, Shape, Real>::add_rigid_work() {
 // shapes also: 2 m_p (c_p dt / h)^2 over the field's particles p, because
 // their feedback (c dt / h)^2 m_p / m grows without bound as a particle
 // enters a cell (|grad S| = 1 / h while S -> 0): USL with linear shapes
-// broke at every cell crossing (the incline block, the rolling disk and
-// the impact scenes stopped with J <= 0 by step 400 at cfl 0.5, a free bar
-// at every cfl from 0.55). With m_L the node's feedback is at most
-// (c dt / h)^2 m_p / m_L = 1/2 per particle that reaches it, summed over
-// them; the factor 2 is measured: at 1, the incline block and a block on a
-// slanted staircase still grew at cfl 0.7.
+// broke at every cell crossing (at cfl 0.5 the incline block and the
+// rolling disk stopped with J <= 0 by step 400, the impact by step 100, a
+// translating free bar at step 5072). With m_L a particle's feedback
+// through a light node is at most (c dt / h)^2 (m_p / m_L) h^2 |grad S|^2
+// = h^2 |grad S|^2 / 2 <= 1 (1.5 in 3D), summed over the particles that
+// reach it; the factor 2 is measured: at 1, the incline block and a block
+// on a slanted staircase still grew at cfl 0.7.
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::set_usl_light_thresholds(const ParticleSeeds& seeds) {
   usl_light_threshold_.clear();
