@@ -93,17 +93,18 @@ struct PairParams {
   bool presence_thin_along_normal = false;
   bool force_limit = true;  // §4.4 (explicit integration only)
   Integration integration = Integration::explicit_;
-  // The (P-20) area on domains with the opening closed (interface law only,
-  // docs/multimaterial.md §7.1); needs g (P-33) whatever the normal.
-  bool closed_area = false;
+  // Interface law only: (P-20) on the domains as they are (paper), on the domains
+  // with the opening closed (closed, docs/multimaterial.md §7.1), or from the
+  // domain gradients (gradient, §7.2). The last two read g (P-33) whatever the normal.
+  ContactArea area = ContactArea::paper;
 };
 
 // Whether a pair reads the domain gradients g (P-33): the mvg, avg and rigid
-// normals, and the closed area (docs/multimaterial.md §7.1).
+// normals, and the closed and gradient areas (docs/multimaterial.md §7.1, §7.2).
 template <class Real>
 bool reads_domain_gradient(const PairParams<Real>& pp) {
   return pp.normal_method == NormalMethod::mvg || pp.normal_method == NormalMethod::avg ||
-         pp.normal_method == NormalMethod::rigid || pp.closed_area;
+         pp.normal_method == NormalMethod::rigid || pp.area != ContactArea::paper;
 }
 
 // Everything the two passes need besides the grid.

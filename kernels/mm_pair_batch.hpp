@@ -239,9 +239,8 @@ void hold_carried_lanes(PairBatch<D, Real>& B) {
 
 // Pass A on the lanes of B: the normal by method M, the pair's law L
 // (Law::interface: the imperfect interface with explicit integration),
-// with Δf in the force limit when UseDf and the closed area when Closed
-// (template parameters: a select on a run-time flag kept GCC from
-// vectorising the loop).
+// with Δf in the force limit when UseDf and the area by rule A (template
+// parameters: a select on a run-time flag kept GCC from vectorising the loop).
 //
 // flatten: every helper called in the lane loop is inlined. A single call
 // left out of line keeps the whole loop scalar, and GCC 12 left different
@@ -249,7 +248,7 @@ void hold_carried_lanes(PairBatch<D, Real>& B) {
 // double, momentum_change_to_center_of_mass in 3D float), which the
 // vectorised_loops test found in build/mmpm (docs/multimaterial.md "Pass A
 // in SIMD lanes").
-template <NormalMethod M, Law L, bool UseDf, bool Closed, int D, class Real>
+template <NormalMethod M, Law L, bool UseDf, ContactArea A, int D, class Real>
 [[gnu::flatten]] void pass_a_lanes(PairBatch<D, Real>& B, Real sign, const std::array<Real, 3>& h,
                                    Real dt, Real thickness) {
   const PairParams<Real>& pp = *B.params;
@@ -262,6 +261,10 @@ template <NormalMethod M, Law L, bool UseDf, bool Closed, int D, class Real>
   const bool force_limit = pp.force_limit;
   const Real Dn = pp.Dn, Dn_compression = pp.Dn_compression, Dt_stiffness = pp.Dt;
   const Real s_out = Real(kDomainGradientOutward);
+  // A copy in registers: with the gradient area h⊥ serves only the position
+  // method's offset, GCC sank its loads under that condition, and masked loads
+  // of the caller's array kept the loop scalar.
+  const std::array<Real, 3> cell{h[0], h[1], h[2]};
   const int count = B.count;
 #pragma GCC ivdep
   for (int i = 0; i < count; ++i) {
@@ -326,7 +329,7 @@ template <NormalMethod M, Law L, bool UseDf, bool Closed, int D, class Real>
       }
       for (int d = 0; d < D; ++d) t[d] = delta_t > 0 ? opening_t[d] * inv_len : perpendicular[d];
     }
-    const Real hp = h_perp<D, Real>(n, h);
+    const Real hp = h_perp<D, Real>(n, cell);
     const Real dn = position_method ? delta_n - contact_offset * hp : delta_n;
     for (int d = 0; d < D; ++d) B.n[d][i] = valid ? n[d] : Real(0);
     B.dn[i] = valid ? dn : Real(0);
@@ -347,16 +350,23 @@ template <NormalMethod M, Law L, bool UseDf, bool Closed, int D, class Real>
       bool perfect_n, perfect_t;
       linear_direction(Dn_now, dn, Tn, kn, en, perfect_n);
       linear_direction(Dt_stiffness, delta_t, Tt, kt, et, perfect_t);
-      ClosedDomains<Real> vol{va, vb};
-      if constexpr (Closed) {  // docs/multimaterial.md §7.1
-        const Real half = Real(0.5) * dn;
-        const Real u_an = dot<D, Real>(lane<D, Real>(B.mx[0][0], i), n) * inv_ma;
-        const Real u_bn = dot<D, Real>(lane<D, Real>(B.mx[1][0], i), n) * inv_mb;
-        vol = close_opening(va, vb, dot<D, Real>(lane<D, Real>(B.g[0][0], i), n),
-                            dot<D, Real>(lane<D, Real>(B.g[1][0], i), n),
-                            position_method ? -half : u_an, position_method ? half : u_bn);
+      Real area;
+      if constexpr (A == ContactArea::gradient) {  // docs/multimaterial.md §7.2
+        area =
+            gradient_contact_area<D, Real>(dot<D, Real>(lane<D, Real>(B.g[0][0], i), n),
+                                           dot<D, Real>(lane<D, Real>(B.g[1][0], i), n), thickness);
+      } else {
+        ClosedDomains<Real> vol{va, vb};
+        if constexpr (A == ContactArea::closed) {  // docs/multimaterial.md §7.1
+          const Real half = Real(0.5) * dn;
+          const Real u_an = dot<D, Real>(lane<D, Real>(B.mx[0][0], i), n) * inv_ma;
+          const Real u_bn = dot<D, Real>(lane<D, Real>(B.mx[1][0], i), n) * inv_mb;
+          vol = close_opening(va, vb, dot<D, Real>(lane<D, Real>(B.g[0][0], i), n),
+                              dot<D, Real>(lane<D, Real>(B.g[1][0], i), n),
+                              position_method ? -half : u_an, position_method ? half : u_bn);
+        }
+        area = contact_area<D, Real>(vol.a, vol.b, hp, thickness);
       }
-      const Real area = contact_area<D, Real>(vol.a, vol.b, hp, thickness);
       const Real m_red = reduced_mass(ma, mb, false);
       VecD<D, Real> df{};
       if constexpr (UseDf)
@@ -480,29 +490,40 @@ template <Law L, int D, class Real>
   }
 }
 
+template <NormalMethod M, ContactArea A, int D, class Real>
+void pass_a_interface_lanes(PairBatch<D, Real>& B, Real sign, const std::array<Real, 3>& h, Real dt,
+                            Real thickness, bool use_force_difference) {
+  if (use_force_difference)
+    return pass_a_lanes<M, Law::interface, true, A>(B, sign, h, dt, thickness);
+  return pass_a_lanes<M, Law::interface, false, A>(B, sign, h, dt, thickness);
+}
+
 template <NormalMethod M, int D, class Real>
 void pass_a_lanes_of_law(PairBatch<D, Real>& B, Real sign, const std::array<Real, 3>& h, Real dt,
                          Real thickness, bool use_force_difference) {
+  constexpr ContactArea kPaper = ContactArea::paper;
   switch (B.params->law) {
     case Law::stick:
-      return pass_a_lanes<M, Law::stick, false, false>(B, sign, h, dt, thickness);
+      return pass_a_lanes<M, Law::stick, false, kPaper>(B, sign, h, dt, thickness);
     case Law::frictionless:
-      return pass_a_lanes<M, Law::frictionless, false, false>(B, sign, h, dt, thickness);
+      return pass_a_lanes<M, Law::frictionless, false, kPaper>(B, sign, h, dt, thickness);
     case Law::friction:
-      return pass_a_lanes<M, Law::friction, false, false>(B, sign, h, dt, thickness);
+      return pass_a_lanes<M, Law::friction, false, kPaper>(B, sign, h, dt, thickness);
     default:
-      // The closed area (docs/multimaterial.md §7.1) as a template flag: an
-      // if or a select on a run-time flag around its loads kept GCC 12 from
-      // vectorising the loop, and computing it in every lane gated by a
-      // product cost the paper's area 5 % of pass A.
-      if (B.params->closed_area) {
-        if (use_force_difference)
-          return pass_a_lanes<M, Law::interface, true, true>(B, sign, h, dt, thickness);
-        return pass_a_lanes<M, Law::interface, false, true>(B, sign, h, dt, thickness);
+      // The area rule (docs/multimaterial.md §7) as a template parameter: an
+      // if or a select on a run-time flag around the closed area's loads kept
+      // GCC 12 from vectorising the loop, and computing it in every lane gated
+      // by a product cost the paper's area 5 % of pass A.
+      switch (B.params->area) {
+        case ContactArea::closed:
+          return pass_a_interface_lanes<M, ContactArea::closed>(B, sign, h, dt, thickness,
+                                                                use_force_difference);
+        case ContactArea::gradient:
+          return pass_a_interface_lanes<M, ContactArea::gradient>(B, sign, h, dt, thickness,
+                                                                  use_force_difference);
+        default:
+          return pass_a_interface_lanes<M, kPaper>(B, sign, h, dt, thickness, use_force_difference);
       }
-      if (use_force_difference)
-        return pass_a_lanes<M, Law::interface, true, false>(B, sign, h, dt, thickness);
-      return pass_a_lanes<M, Law::interface, false, false>(B, sign, h, dt, thickness);
   }
 }
 

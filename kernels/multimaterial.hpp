@@ -432,15 +432,21 @@ InteractionResult<D, Real> interact_pass_a(
 
   r.evaluated = true;
   const Traction<Real> tr = evaluate_traction(pp, dn, G.delta_t);
-  ClosedDomains<Real> vol{a.vol, b.vol};
-  if (pp.closed_area) {
-    const bool known = pp.separation != Separation::position;  // mx holds displacements
-    const Real half = Real(0.5) * dn;
-    vol = close_opening(a.vol, b.vol, dot<D, Real>(a.g, G.n), dot<D, Real>(b.g, G.n),
-                        known ? dot<D, Real>(a.mx, G.n) / a.m : -half,
-                        known ? dot<D, Real>(b.mx, G.n) / b.m : half);
+  Real area;
+  if (pp.area == ContactArea::gradient) {
+    area =
+        gradient_contact_area<D, Real>(dot<D, Real>(a.g, G.n), dot<D, Real>(b.g, G.n), thickness);
+  } else {
+    ClosedDomains<Real> vol{a.vol, b.vol};
+    if (pp.area == ContactArea::closed) {
+      const bool known = pp.separation != Separation::position;  // mx holds displacements
+      const Real half = Real(0.5) * dn;
+      vol = close_opening(a.vol, b.vol, dot<D, Real>(a.g, G.n), dot<D, Real>(b.g, G.n),
+                          known ? dot<D, Real>(a.mx, G.n) / a.m : -half,
+                          known ? dot<D, Real>(b.mx, G.n) / b.m : half);
+    }
+    area = contact_area<D, Real>(vol.a, vol.b, G.h_perp, thickness);
   }
-  const Real area = contact_area<D, Real>(vol.a, vol.b, G.h_perp, thickness);
   const Real m_red = reduced_mass(a.m, b.m, b_is_rigid);
   VecD<D, Real> df{};
   if (use_force_difference) df = force_difference<D, Real>(a.m, a.f, b.m, b.f, b_is_rigid);

@@ -715,6 +715,32 @@ TEST(Cli, ExtrapolatedSeparationWithOneParticlePerCellWarns) {
   EXPECT_EQ(two.err, "") << two.describe();
 }
 
+// docs/multimaterial.md §7.2, app/start_warnings.cpp. With B-splines, (P-20)
+// named in the scene warns (it counts each row of interface nodes in full);
+// the default gradient area warns for a body thinner than the shape's two
+// reaches with the partner on both faces: the DLS's 2-cell central lap at
+// h = 0.5 mm (not its outer laps, free on one face), and nothing at h = 0.25.
+TEST(Cli, BSplineInterfaceAreaWarnings) {
+  const std::string bars = source_dir() + "/inputs/series_bars.toml";
+  const std::string paper =
+      one_interaction_warning(run_mmpm({"check", bars, "--set", "grid.shape=\"bspline3\"", "--set",
+                                        "interaction[0].area=\"paper\""}),
+                              bars, "area");
+  EXPECT_TRUE(contains(paper, "0.65 of the exact")) << paper;
+  const CmdResult bars_default = run_mmpm({"check", bars, "--set", "grid.shape=\"bspline3\""});
+  EXPECT_EQ(bars_default.exit_code, 0) << bars_default.describe();
+  EXPECT_EQ(bars_default.err, "") << bars_default.describe();
+
+  const std::string dls = source_dir() + "/inputs/dls.toml";
+  const std::string thin = one_interaction_warning(
+      run_mmpm({"check", dls, "--set", "grid.shape=\"bspline2\""}), dls, "area");
+  EXPECT_TRUE(contains(thin, "body 'central' is 2 cells thick along x")) << thin;
+  const CmdResult fine = run_mmpm({"check", dls, "--set", "grid.shape=\"bspline2\"", "--set",
+                                   "grid.cell=[0.25,0.25]", "--set", "grid.cells=[20,148]"});
+  EXPECT_EQ(fine.exit_code, 0) << fine.describe();
+  EXPECT_EQ(fine.err, "") << fine.describe();
+}
+
 // An interface between bodies that start bonded, with separation =
 // "position": the centroids' offset loads it from the first step (two_layer
 // with Dn = 1000 made 5.2 mJ from 0.0019 mJ of work in 0.01 ms), so `check`

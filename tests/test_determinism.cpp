@@ -288,6 +288,17 @@ TEST(Determinism, ImperfectInterfaceClosedArea2D) {
   EXPECT_GT(r.energies.interface, 0.0);
 }
 
+// area = "gradient" (docs/multimaterial.md §7.2), the B-splines' default: g
+// scattered for a specified normal, quadratic B-splines, float.
+TEST(Determinism, ImperfectInterfaceGradientAreaBSpline2DFloat) {
+  BoxScene2D s = two_materials("float", std::string(kNumericInterface));
+  s.shape = "bspline2";
+  s.scheme = "MUSL";
+  const RunResult r = check_scene(s.text(), "2D bspline2 float", 40.0);
+  EXPECT_GT(r.counters.multimaterial_nodes, 0);
+  EXPECT_GT(r.energies.interface, 0.0);
+}
+
 // The bilinear law's perfect compression branch, one-sided (docs/multimaterial.md
 // §4.1), decided in pass A and again in pass B: the blocks pushed into each other.
 TEST(Determinism, ImperfectInterfaceBilinearPerfectCompression2D) {

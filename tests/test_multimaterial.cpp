@@ -822,6 +822,64 @@ TEST(MultimaterialGeometry, ClosedAreaSumsToTheClosedInterface) {
   EXPECT_EQ(clamped.b, 0.0);
 }
 
+// gradient_contact_area (area = "gradient", docs/multimaterial.md §7.2) on the exact
+// domains of a 1D continuum, h = 1: a fills x < s_a, b fills x > s_b, n = +x, so
+// g_a · n = S(s_a − j) and g_b · n = −S(s_b − j). For the tent and both B-splines, with
+// the interface anywhere in its cell, the nodes that hold both materials must sum to
+// the interface, 1: to round-off when it is closed, and within δ/2 (the tent's node
+// past the gap holds no a) when it is open by δ = 0.01. (P-20) on the same nodes sums
+// to 1 for the tent only; it reads 1.15 (midplane) to 1.41 (grid line) for the
+// quadratic B-spline and 1.41 to 1.58 for the cubic, so it is not even independent of
+// where the interface lies (the test asserts > 1.1 as the contrast).
+double kernel_1d(int shape, double x) {  // 0 tent, 2 quadratic, 3 cubic B-spline
+  const double r = std::abs(x);
+  if (shape == 0) return std::max(0.0, 1 - r);
+  if (shape == 2) return r < 0.5 ? 0.75 - r * r : r < 1.5 ? 0.5 * (1.5 - r) * (1.5 - r) : 0.0;
+  return r < 1 ? 2.0 / 3 - r * r + 0.5 * r * r * r : r < 2 ? (2 - r) * (2 - r) * (2 - r) / 6 : 0.0;
+}
+
+double kernel_integral_below(int shape, double s) {  // ∫_{-∞}^{s} S dx, midpoint rule
+  if (shape == 0) return tent_integral_below(s);
+  const int n = 20000;
+  const double lo = -2.0, hi = std::min(s, 2.0);
+  if (hi <= lo) return 0;
+  double sum = 0;
+  for (int k = 0; k < n; ++k) sum += kernel_1d(shape, lo + (k + 0.5) * (hi - lo) / n);
+  return sum * (hi - lo) / n;
+}
+
+TEST(MultimaterialGeometry, GradientAreaSumsToTheInterfaceForEveryShape) {
+  for (int shape : {0, 2, 3})
+    for (double s : {0.0, 0.2, 0.5, 0.73})
+      for (double delta : {0.0, 0.01}) {
+        SCOPED_TRACE("shape " + std::to_string(shape) + " s " + std::to_string(s) + " delta " +
+                     std::to_string(delta));
+        double gradient = 0, paper = 0;
+        for (int j = -4; j <= 5; ++j) {
+          const double va = kernel_integral_below(shape, s - j);
+          const double vb = 1 - kernel_integral_below(shape, s + delta - j);
+          if (va <= 1e-12 || vb <= 1e-12) continue;  // the node lacks a material
+          gradient += mmpm::gradient_contact_area<3, double>(kernel_1d(shape, s - j),
+                                                             -kernel_1d(shape, s + delta - j), 1.0);
+          paper += mmpm::contact_area<3, double>(va, vb, 1.0, 1.0);
+        }
+        if (delta == 0) std::printf("[area 1D] shape %d s %.2f paper %.4f\n", shape, s, paper);
+        EXPECT_NEAR(gradient, 1.0, delta > 0 ? delta / 2 + 1e-12 : 1e-12);
+        if (delta == 0) {
+          if (shape == 0) {
+            EXPECT_NEAR(paper, 1.0, 1e-6);
+          } else {
+            EXPECT_GT(paper, 1.1);
+          }
+        }
+      }
+  // The sign of n does not matter (a specified normal that points b → a), and the
+  // thickness multiplies in 2D only.
+  EXPECT_EQ((mmpm::gradient_contact_area<2, double>(-0.75, 0.75, 3.0)), 2.25);
+  EXPECT_EQ((mmpm::gradient_contact_area<2, double>(0.75, -0.75, 3.0)), 2.25);
+  EXPECT_EQ((mmpm::gradient_contact_area<3, double>(0.75, -0.75, 3.0)), 0.75);
+}
+
 TEST(MultimaterialGeometry, TotalInterfaceForceIndependentOfInterfaceLocation) {
   // The same two configurations through the pass: uniform tangential opening δ_t = 0.01,
   // D_t = 10, normal +x. Total tangential force on a = D_t δ_t t Δy in both.

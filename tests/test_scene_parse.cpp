@@ -441,6 +441,25 @@ TEST(SceneParseValid, Full2DSceneBodies) {
   EXPECT_DOUBLE_EQ(disk.radius, 1.5);
 }
 
+// docs/multimaterial.md §7.2: (P-20) counts each of the B-splines' rows of
+// interface nodes in full, so their interfaces default to the gradient area;
+// an area the scene names is kept, and linear and uGIMP keep the paper's.
+TEST(SceneParseValid, BSplineInterfacesDefaultToTheGradientArea) {
+  const std::string grid = "cells = [20, 20]\n";
+  for (const auto& [shape, expected] :
+       {std::pair{"linear", ContactArea::paper}, std::pair{"gimp", ContactArea::paper},
+        std::pair{"bspline2", ContactArea::gradient},
+        std::pair{"bspline3", ContactArea::gradient}}) {
+    std::string text = kBase;
+    text.replace(text.find(grid), grid.size(), grid + "shape = \"" + shape + "\"\n");
+    EXPECT_EQ(parse_scene_text(text, "base.toml").interactions[0].area, expected) << shape;
+    const std::string law = "Dt = 5.0\n";
+    text.replace(text.find(law), law.size(), law + "area = \"paper\"\n");
+    EXPECT_EQ(parse_scene_text(text, "base.toml").interactions[0].area, ContactArea::paper)
+        << shape;
+  }
+}
+
 TEST(SceneParseValid, Full2DSceneInteractions) {
   const Scene s = parse_scene_text(kFull2D, "full.toml");
   ASSERT_EQ(s.interactions.size(), 2u);
@@ -948,7 +967,7 @@ TEST(SceneParseErrors, InteractionValues) {
                         {"got \"stiff\""});
   inter("axis = [0.0, 0.0, 1.0]", "interaction[0].axis", {"applies to normal = \"radial\" only"});
   inter("area = \"open\"", "interaction[0].area",
-        {"expected one of \"paper\", \"closed\", got \"open\""});
+        {"expected one of \"paper\", \"closed\", \"gradient\", got \"open\""});
   const Mutation area_of_contact =
       mutate(kBase, "law = \"interface\"\n", "law = \"frictionless\"\narea = \"closed\"\n");
   expect_error(area_of_contact.text, area_of_contact.line + 1, "interaction[0].area",

@@ -68,8 +68,10 @@ inline constexpr std::array<EnumName<Integration>, 2> kIntegrationNames{
     {{"explicit", Integration::explicit_}, {"exact", Integration::exact}}};
 inline constexpr std::array<EnumName<TractionLaw>, 2> kTractionLawNames{
     {{"linear", TractionLaw::linear}, {"bilinear", TractionLaw::bilinear}}};
-inline constexpr std::array<EnumName<ContactArea>, 2> kContactAreaNames{
-    {{"paper", ContactArea::paper}, {"closed", ContactArea::closed}}};
+inline constexpr std::array<EnumName<ContactArea>, 3> kContactAreaNames{
+    {{"paper", ContactArea::paper},
+     {"closed", ContactArea::closed},
+     {"gradient", ContactArea::gradient}}};
 inline constexpr std::array<EnumName<LoadKind>, 2> kLoadKindNames{
     {{"traction", LoadKind::traction}, {"gravity", LoadKind::gravity}}};
 inline constexpr std::array<EnumName<ParticleOrder>, 2> kParticleOrderNames{

@@ -1321,6 +1321,12 @@ class SceneReader {
     }
     if (auto f = t.get("force_limit")) in.force_limit = f->boolean();
     if (auto f = t.get("integration")) in.integration = f->choice(kIntegrationNames);
+    // (P-20) counts every row of interface nodes in full, and the B-splines put
+    // an interface in two or three rows: their default reads the interface's
+    // share of each node from the domain gradients (docs/multimaterial.md §7.2).
+    const ShapeKind shape = scene_.grid.shape;
+    if (shape == ShapeKind::bspline2 || shape == ShapeKind::bspline3)
+      in.area = ContactArea::gradient;
     if (auto f = t.get("area")) {
       if (!interface)
         f->fail("area applies to law = \"interface\" only (the contact area of P-20)");

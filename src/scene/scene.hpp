@@ -28,9 +28,11 @@ enum class NormalMethod { mvg, avg, specified, radial, rigid, geometry };
 enum class Separation { displacement, position, extrapolated };
 enum class Integration { explicit_, exact };
 enum class TractionLaw { linear, bilinear };  // bilinear: stiff in compression (ALGORITHM §3.2)
-// Nodal domains of the contact area (P-20): as they are (the paper), or with the
-// interface's opening closed first (docs/multimaterial.md §7.1).
-enum class ContactArea { paper, closed };
+// The contact area of an interface node: (P-20) on the nodal domains as they are
+// (paper) or with the interface's opening closed first (closed, docs/multimaterial.md
+// §7.1), or the interface's share of the node read from the domain gradients
+// (gradient, §7.2: the one that holds for the B-splines' several node rows).
+enum class ContactArea { paper, closed, gradient };
 enum class LoadKind { traction, gravity };
 enum class ParticleOrder { color, tile };  // storage order of the sorted particles
 

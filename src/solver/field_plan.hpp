@@ -34,13 +34,14 @@ inline std::vector<std::size_t> materials_in_field(const FieldPlan& plan, int fi
 }
 
 // Whether some interaction computes its normal from the domain gradients
-// g_i (P-33: mvg, avg, rigid) or closes an interface's opening before its
-// area (docs/multimaterial.md §7.1). Only then does P2G scatter g.
+// g_i (P-33: mvg, avg, rigid) or reads an interface's area from them (the
+// closed and gradient areas, docs/multimaterial.md §7.1, §7.2). Only then does
+// P2G scatter g.
 inline bool needs_domain_gradient(const FieldPlan& plan) {
   for (const InteractionSpec& it : plan.laws)
     if (it.normal == NormalMethod::mvg || it.normal == NormalMethod::avg ||
         it.normal == NormalMethod::rigid || it.normal == NormalMethod::geometry ||
-        (it.law == Law::interface && it.area == ContactArea::closed))
+        (it.law == Law::interface && it.area != ContactArea::paper))
       return true;
   return false;
 }

@@ -77,7 +77,7 @@ class MultimaterialStage {
       pp.presence_thin_along_normal = tangential_tie;
       pp.force_limit = it.force_limit;
       pp.integration = it.integration;
-      pp.closed_area = it.law == Law::interface && it.area == ContactArea::closed;
+      if (it.law == Law::interface) pp.area = it.area;
       if (it.law == Law::interface) has_interface_ = true;
       params_.push_back(pp);
     }
