@@ -68,13 +68,6 @@ std::vector<std::string> computed_normal_warnings(const Scene& scene) {
   return out;
 }
 
-// docs/multimaterial.md §7.2. (P-20) gives every row of interface nodes a full
-// share, and the B-splines put an interface in two or three rows: the series
-// bars read U_int 0.740 (bspline2) and 0.650 (bspline3) of the exact value.
-// The gradient area (their default) reads the share of each row; but where
-// one node sees the same partner across both faces of a thin body, the two
-// faces' shares cancel: the double lap shear with a 2-cell central lap reads
-// U_int +20 % (bspline2) and +28 % (bspline3), with a 4-cell lap -1 %.
 // A body's bounding box within its clip box.
 std::pair<Vec3, Vec3> filled_bounds(const BodySpec& b, int dim) {
   auto [lo, hi] = shape_bounds(b, dim);
@@ -87,12 +80,44 @@ std::pair<Vec3, Vec3> filled_bounds(const BodySpec& b, int dim) {
   return {lo, hi};
 }
 
+// The first axis along which body b is thinner than `cells` cells and has a
+// body of material `partner` beside both of its faces (within `reach` cells
+// of the face, overlapping b across the other axes); -1 if none.
+int thin_between_partners(const Scene& scene, const BodySpec& b, const std::string& partner,
+                          double cells, double reach) {
+  const int dim = scene.simulation.dimension;
+  const auto [lo, hi] = filled_bounds(b, dim);
+  for (int d = 0; d < dim; ++d) {
+    const double h = scene.grid.cell[d];
+    if (hi[d] - lo[d] >= cells * h) continue;
+    bool below = false, above = false;
+    for (const BodySpec& p : scene.bodies) {
+      if (p.material != partner) continue;
+      const auto [plo, phi] = filled_bounds(p, dim);
+      bool across = true;
+      for (int e = 0; e < dim; ++e)
+        if (e != d && (phi[e] <= lo[e] || plo[e] >= hi[e])) across = false;
+      if (!across) continue;
+      below = below || (plo[d] < lo[d] && phi[d] > lo[d] - reach * h);
+      above = above || (phi[d] > hi[d] && plo[d] < hi[d] + reach * h);
+    }
+    if (below && above) return d;
+  }
+  return -1;
+}
+
+// docs/multimaterial.md §7.2. (P-20) gives every row of interface nodes a full
+// share, and the B-splines put an interface in three rows: the series bars
+// read U_int 0.740 (bspline2) and 0.650 (bspline3) of the exact value. The
+// gradient area (their default) reads the share of each row; but where one
+// node sees the same partner across both faces of a thin body, the two
+// faces' shares cancel: the double lap shear with a 2-cell central lap reads
+// U_int +20 % (bspline2) and +28 % (bspline3), with a 4-cell lap -1 %.
 std::vector<std::string> bspline_area_warnings(const Scene& scene) {
   std::vector<std::string> out;
   const ShapeKind shape = scene.grid.shape;
   if (shape != ShapeKind::bspline2 && shape != ShapeKind::bspline3) return out;
   const double reach = shape == ShapeKind::bspline2 ? 1.5 : 2.0;  // cells
-  const int dim = scene.simulation.dimension;
   for (std::size_t k = 0; k < scene.interactions.size(); ++k) {
     const InteractionSpec& it = scene.interactions[k];
     if (it.law != Law::interface) continue;
@@ -112,36 +137,19 @@ std::vector<std::string> bspline_area_warnings(const Scene& scene) {
       if (b.material != it.materials[0] && b.material != it.materials[1]) continue;
       const std::string& partner =
           b.material == it.materials[0] ? it.materials[1] : it.materials[0];
-      const auto [lo, hi] = filled_bounds(b, dim);
-      for (int d = 0; d < dim; ++d) {
-        const double h = scene.grid.cell[d], cells = (hi[d] - lo[d]) / h;
-        if (cells >= 2 * reach) continue;
-        // A body of the partner beside each face along d, within reach of it
-        // and overlapping b across the other axes.
-        bool below = false, above = false;
-        for (const BodySpec& p : scene.bodies) {
-          if (p.material != partner) continue;
-          const auto [plo, phi] = filled_bounds(p, dim);
-          bool across = true;
-          for (int e = 0; e < dim; ++e)
-            if (e != d && (phi[e] <= lo[e] || plo[e] >= hi[e])) across = false;
-          if (!across) continue;
-          below = below || (plo[d] < lo[d] && phi[d] > lo[d] - reach * h);
-          above = above || (phi[d] > hi[d] && plo[d] < hi[d] + reach * h);
-        }
-        if (!below || !above) continue;
-        std::ostringstream m;
-        m << interaction_warning(scene, k, "area") << "body '" << b.name << "' is "
-          << format_number(cells) << " cells thick along "
-          << "xyz"[d] << ", less than the " << format_number(2 * reach) << " cells "
-          << scene_name(shape) << " needs, with '" << partner
-          << "' on both faces: nodes between them see both faces, and their "
-          << "shares of the gradient area cancel (a double lap shear with a 2-cell central "
-             "lap reads the interface energy +20 % with bspline2, with a 4-cell lap -1 %); "
-             "refine the grid";
-        out.push_back(m.str());
-        break;
-      }
+      const int d = thin_between_partners(scene, b, partner, 2 * reach, reach);
+      if (d < 0) continue;
+      const auto [lo, hi] = filled_bounds(b, scene.simulation.dimension);
+      std::ostringstream m;
+      m << interaction_warning(scene, k, "area") << "body '" << b.name << "' is "
+        << format_number((hi[d] - lo[d]) / scene.grid.cell[d]) << " cells thick along "
+        << "xyz"[d] << ", less than the " << format_number(2 * reach) << " cells "
+        << scene_name(shape) << " needs, with '" << partner
+        << "' on both faces: nodes between them see both faces, and their "
+        << "shares of the gradient area cancel (a double lap shear with a 2-cell central "
+           "lap reads the interface energy +20 % with bspline2, with a 4-cell lap -1 %); "
+           "refine the grid";
+      out.push_back(m.str());
     }
   }
   return out;
