@@ -68,32 +68,20 @@ std::vector<std::string> computed_normal_warnings(const Scene& scene) {
   return out;
 }
 
-// A body's bounding box within its clip box.
-std::pair<Vec3, Vec3> filled_bounds(const BodySpec& b, int dim) {
-  auto [lo, hi] = shape_bounds(b, dim);
-  if (b.clip) {
-    for (int d = 0; d < dim; ++d) {
-      lo[d] = std::max(lo[d], b.clip->first[d]);
-      hi[d] = std::min(hi[d], b.clip->second[d]);
-    }
-  }
-  return {lo, hi};
-}
-
 // The first axis along which body b is thinner than `cells` cells and has a
 // body of material `partner` beside both of its faces (within `reach` cells
 // of the face, overlapping b across the other axes); -1 if none.
 int thin_between_partners(const Scene& scene, const BodySpec& b, const std::string& partner,
                           double cells, double reach) {
   const int dim = scene.simulation.dimension;
-  const auto [lo, hi] = filled_bounds(b, dim);
+  const auto [lo, hi] = body_bounds(b, dim);
   for (int d = 0; d < dim; ++d) {
     const double h = scene.grid.cell[d];
     if (hi[d] - lo[d] >= cells * h) continue;
     bool below = false, above = false;
     for (const BodySpec& p : scene.bodies) {
       if (p.material != partner) continue;
-      const auto [plo, phi] = filled_bounds(p, dim);
+      const auto [plo, phi] = body_bounds(p, dim);
       bool across = true;
       for (int e = 0; e < dim; ++e)
         if (e != d && (phi[e] <= lo[e] || plo[e] >= hi[e])) across = false;
@@ -139,7 +127,7 @@ std::vector<std::string> bspline_area_warnings(const Scene& scene) {
           b.material == it.materials[0] ? it.materials[1] : it.materials[0];
       const int d = thin_between_partners(scene, b, partner, 2 * reach, reach);
       if (d < 0) continue;
-      const auto [lo, hi] = filled_bounds(b, scene.simulation.dimension);
+      const auto [lo, hi] = body_bounds(b, scene.simulation.dimension);
       std::ostringstream m;
       m << interaction_warning(scene, k, "area") << "body '" << b.name << "' is "
         << format_number((hi[d] - lo[d]) / scene.grid.cell[d]) << " cells thick along "

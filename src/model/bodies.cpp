@@ -28,8 +28,9 @@ Vec3 box_center(const BodySpec& b) {
   return {0.5 * (b.min[0] + b.max[0]), 0.5 * (b.min[1] + b.max[1]), 0.5 * (b.min[2] + b.max[2])};
 }
 
-// Bounding box of a body in global coordinates.
-std::pair<Vec3, Vec3> bounds(const BodySpec& b, int dim) {
+}  // namespace
+
+std::pair<Vec3, Vec3> body_bounds(const BodySpec& b, int dim) {
   Vec3 lo{0, 0, 0}, hi{0, 0, 0};
   switch (b.shape) {
     case BodyShape::box: {
@@ -66,6 +67,8 @@ std::pair<Vec3, Vec3> bounds(const BodySpec& b, int dim) {
   }
   return {lo, hi};
 }
+
+namespace {
 
 // The seeded particles of each grid cell, as lists threaded through the
 // particles (head per cell, next per particle), for the replacement of
@@ -115,7 +118,7 @@ class SeedCells {
 std::pair<Vec3, Vec3> shape_bounds(const BodySpec& b, int dimension) {
   BodySpec shape = b;
   shape.clip.reset();
-  return bounds(shape, dimension);
+  return body_bounds(shape, dimension);
 }
 
 bool inside_polygon(const std::vector<Vec3>& pts, double x, double y) {
@@ -184,7 +187,7 @@ ParticleSeeds make_particles(const Scene& scene) {
   for (std::size_t bi = 0; bi < scene.bodies.size(); ++bi) {
     const BodySpec& body = scene.bodies[bi];
     const int ppc = body.particles_per_cell;
-    auto [lo, hi] = bounds(body, dim);
+    auto [lo, hi] = body_bounds(body, dim);
     std::array<int, 3> c0{0, 0, 0}, c1{0, 0, 0};
     for (int d = 0; d < dim; ++d) {
       c0[d] = std::max(0, int(std::floor((lo[d] - g.origin[d]) / g.cell[d])));

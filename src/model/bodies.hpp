@@ -41,6 +41,9 @@ struct BodyFrame {
   Vec3 origin{0, 0, 0};
 };
 
+// The bounding box of a body in global coordinates, within its clip box.
+std::pair<Vec3, Vec3> body_bounds(const BodySpec& b, int dimension);
+
 // The bounding box of a body's shape, its clip box left out.
 std::pair<Vec3, Vec3> shape_bounds(const BodySpec& b, int dimension);
 
