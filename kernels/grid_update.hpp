@@ -112,13 +112,20 @@ template <int D, class Real, bool Interface, bool Damping, bool Velocities, bool
       // loop (where the select makes an add conditional) and in its scalar
       // remainder, so a node's bits depended on where a thread's range
       // began (tests/test_node_ownership.cpp caught it).
+      // A light node scales its whole force, gravity and the interface
+      // force too: at equilibrium they balance f, and scaled apart they left
+      // the momentum and dvel each a part that no longer balanced (a static
+      // interface kept a particle-velocity mode, docs/validation.md §3.5).
+      // keep = 1 (every heavy node, MUSL, USF) multiplies exactly: the same
+      // bits as without the scaling.
       Real force = std::fma(m, gacc[d], f_[d][n]);
-      Real damped = std::fma(-alpha, p, std::fma(m, gacc[d], f_[d][n] * keep));
-      if constexpr (Interface) force += fi_[d][n], damped += fi_[d][n];
+      Real damped = std::fma(-alpha, p, std::fma(m * keep, gacc[d], f_[d][n] * keep));
+      if constexpr (Interface) force += fi_[d][n], damped += fi_[d][n] * keep;
       const Real sliver = some ? dt * force / m : Real(0);
       const Real updated = std::fma(dt, damped, p);
-      // The light node's force left out of the momentum, for dvel: 0 elsewhere.
-      const Real left_out = dt * f_[d][n] * (Real(1) - keep) * inv_m;
+      // The light node's force left out of the momentum, for dvel: 0 elsewhere
+      // (left_out_velocity, kernels/mm_left_out.hpp, forms it again for pass B).
+      const Real left_out = dt * force * (Real(1) - keep) * inv_m;
       if constexpr (Velocities) {
         // grid_velocities' formulas on the updated momentum.
         vel_[d][n] = heavy ? updated * inv_m : Real(0);

@@ -134,6 +134,14 @@ struct MMConfig {
   // Two-material nodes of one pair in SIMD batches (kernels/mm_pair_batch.hpp).
   // false: every node by the per-node path; the tests compare the two.
   bool batch_pairs = true;
+  // USL only (null otherwise): per field the light-node mass m_L, and the
+  // grid's dvel, where update_deformable put a light field's left-out force.
+  // Pass B after the update moves it where it sticks a pair
+  // (kernels/mm_left_out.hpp).
+  const Real* light_mass = nullptr;
+  std::array<Real*, D> light_dvel{};
+  std::array<Real, 3> light_gravity{};         // the step's gravity (the update's)
+  const unsigned char* light_fixed = nullptr;  // per node: bit d, a support fixes axis d
 };
 
 // Per-step diagnostics. Both passes ADD to it; reset() before pass A of a step.

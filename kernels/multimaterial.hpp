@@ -33,6 +33,7 @@
 #include "kernels/mm_common.hpp"
 #include "kernels/mm_contact.hpp"
 #include "kernels/mm_interface.hpp"
+#include "kernels/mm_left_out.hpp"
 #include "kernels/mm_normals.hpp"
 #include "kernels/mm_pair_batch.hpp"
 #include "kernels/node_ownership.hpp"
@@ -65,6 +66,7 @@ struct InteractionResult {
   bool evaluated = false;           // false: screened (§3 Ω_min) or no normal
   bool held = false;   // pass B: a contact law applied, or a one-sided normal stuck (kHeldInPassB)
   bool stuck = false;  // pass B: held by a contact that did not slide (kStuckInPassB)
+  VecD<D, Real> normal{};  // pass B: the pair's normal (for exchange_left_out)
 };
 
 // Geometry and kinematics of a pair at a node (§3, P-7 … P-15).
@@ -488,10 +490,13 @@ InteractionResult<D, Real> interact_pass_b(const MaterialSide<D, Real>& a,
       screened_geometry<D, Real>(a, b, b_is_rigid, pp, sign, node_position, h);
   if (!G.valid) return r;
   if (pp.law != Law::interface)
-    return contact_result<D, Real>(
+    r = contact_result<D, Real>(
         G, pp, corrected_normal_separation(pp.separation, G.delta_n, G.h_perp, pp.contact_offset),
         held_before(stick_flags, strain_pass), stuck_before(stick_flags, strain_pass));
-  return interface_stick_result<D, Real>(G, stick_flags, strain_pass);
+  else
+    r = interface_stick_result<D, Real>(G, stick_flags, strain_pass);
+  r.normal = G.n;
+  return r;
 }
 
 // Pass B from pass A's saved geometry: the same outcome as interact_pass_b
@@ -510,9 +515,12 @@ InteractionResult<D, Real> interact_pass_b_saved(const MaterialSide<D, Real>& a,
   G.n = saved.n;
   G.dp = momentum_change_to_center_of_mass<D, Real>(a.m, a.p, b.m, b.p, b_is_rigid);
   if (pp.law != Law::interface)
-    return contact_result<D, Real>(G, pp, saved.dn, held_before(stick_flags, strain_pass),
-                                   stuck_before(stick_flags, strain_pass));
-  return interface_stick_result<D, Real>(G, stick_flags, strain_pass);
+    r = contact_result<D, Real>(G, pp, saved.dn, held_before(stick_flags, strain_pass),
+                                stuck_before(stick_flags, strain_pass));
+  else
+    r = interface_stick_result<D, Real>(G, stick_flags, strain_pass);
+  r.normal = G.n;
+  return r;
 }
 
 // The fields present at a node, gathered into contiguous local arrays.
@@ -683,7 +691,15 @@ void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::si
       cs.limited += r.limited;
       flags_out[k * std::size_t(F) + std::size_t(fa)] = r.stick;
     } else {
-      record_held(flags_out, k * std::size_t(F) + std::size_t(fa), r.held, r.stuck);
+      const std::size_t slot = k * std::size_t(F) + std::size_t(fa);
+      record_held(flags_out, slot, r.held, r.stuck);
+      if (cfg.light_mass) {  // USL: a light field's left-out force where the pair stuck
+        const VecD<D, Real> taken = exchange_left_out<D, Real>(
+            grid, cfg.light_mass, cfg.light_dvel, cfg.light_gravity, cfg.dt, node, fa, fb, b_rigid,
+            stuck_directions(pp->law, flags_in[slot], r.held, r.stuck), r.normal,
+            cfg.light_fixed ? cfg.light_fixed[node] : 0);
+        if (b_rigid) add_reaction<D, Real>(cs, fb, taken, VecD<D, Real>{}, inv_dt);
+      }
     }
     return;
   }
@@ -730,7 +746,18 @@ void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::si
       cs.limited += r.limited;
       flags_out[k * std::size_t(F) + std::size_t(fa)] = r.stick;
     } else {
-      record_held(flags_out, k * std::size_t(F) + std::size_t(fa), r.held, r.stuck);
+      const std::size_t slot = k * std::size_t(F) + std::size_t(fa);
+      record_held(flags_out, slot, r.held, r.stuck);
+      // USL's left-out force against a rigid partner (which changes dvel and
+      // the reaction only). Against a lump of deformable partners it is left
+      // in dvel: the lump's fields do not share one stuck velocity.
+      if (cfg.light_mass && b_rigid) {
+        const VecD<D, Real> taken = exchange_left_out<D, Real>(
+            grid, cfg.light_mass, cfg.light_dvel, cfg.light_gravity, cfg.dt, node, fa,
+            nf.field[partner], true, stuck_directions(pp.law, flags_in[slot], r.held, r.stuck),
+            r.normal, cfg.light_fixed ? cfg.light_fixed[node] : 0);
+        add_reaction<D, Real>(cs, nf.field[partner], taken, VecD<D, Real>{}, inv_dt);
+      }
     }
   }
   for (int ia = 0; ia < K; ++ia) apply(nf.field[ia], change[ia], force[ia], Real(1));
@@ -904,9 +931,19 @@ void process_chunk(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg,
       grid.p[d][at_a + node] += B.change[d][i];
       grid.p[d][at_b + node] += -B.change[d][i];
     }
-    if constexpr (!kPassA)
-      record_held(flags_out, k * std::size_t(cfg.fields) + std::size_t(B.field_a),
-                  B.held[i] != Real(0), B.stuck[i] != Real(0));
+    if constexpr (!kPassA) {
+      const std::size_t slot = k * std::size_t(cfg.fields) + std::size_t(B.field_a);
+      const bool held = B.held[i] != Real(0), stuck = B.stuck[i] != Real(0);
+      record_held(flags_out, slot, held, stuck);
+      if (cfg.light_mass) {  // as process_node
+        VecD<D, Real> n;
+        for (int d = 0; d < D; ++d) n[d] = B.n[d][i];
+        exchange_left_out<D, Real>(grid, cfg.light_mass, cfg.light_dvel, cfg.light_gravity, cfg.dt,
+                                   node, B.field_a, B.field_b, false,
+                                   stuck_directions(B.params->law, B.stick[i], held, stuck), n,
+                                   cfg.light_fixed ? cfg.light_fixed[node] : 0);
+      }
+    }
     if constexpr (kPassA) {
       if (with_force)
         for (int d = 0; d < D; ++d) {

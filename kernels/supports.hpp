@@ -22,6 +22,7 @@
 
 #include "kernels/grid_update.hpp"
 #include "kernels/grid_view.hpp"
+#include "kernels/light_nodes.hpp"
 
 namespace mmpm {
 
@@ -47,6 +48,14 @@ struct Supports {
   // terms (only that application is the support's impulse for the step;
   // USF and MUSL also enforce the supports on their other transfers).
   bool with_dvel = false;
+  // USL (with_dvel only; null otherwise): per field the light-node mass m_L
+  // and the step's gravity. A fixed component also takes a light node's
+  // left-out velocity out of dvel (kernels/light_nodes.hpp), into the
+  // reaction: left there, the support held the node while its particles
+  // took that part every step (a velocity mode at the symmetry planes of
+  // a static sphere in a cube).
+  const double* light = nullptr;
+  Real gravity[3] = {0, 0, 0};
 };
 
 // The supports on nodes [b, e) of field f (indices within the field).
@@ -55,6 +64,7 @@ void apply_supports(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
                     const Supports<Real>& S, int f, std::size_t b, std::size_t e) {
   if (S.count == 0 || (S.rigid && S.rigid[f])) return;
   const std::size_t o = std::size_t(f) * G.nodes;
+  const Real light = S.with_dvel && S.light ? Real(S.light[f]) : Real(0);
   for (std::size_t s = 0; s < S.count; ++s) {
     const SupportView<Real>& bc = S.list[s];
     const std::uint32_t* first = std::lower_bound(bc.nodes, bc.nodes + bc.count, b);
@@ -81,8 +91,10 @@ void apply_supports(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
         V.vel[d][i] = v_target;
         G.p[d][i] = m * v_target;
         if (S.with_dvel) {
-          V.dvel[d][i] += change;
-          terms[k * D + d] = double(m) * double(change) / S.dt;
+          const Real held =
+              change - light_left_out<D, Real>(G, i, d, m, light, S.gravity[d], Real(S.dt));
+          V.dvel[d][i] += held;
+          terms[k * D + d] = double(m) * double(held) / S.dt;
         }
       }
     }

@@ -238,6 +238,29 @@ TEST(Determinism, ImperfectInterfacePerfectNormal2D) {
       << "the multimaterial passes must run on two threads";
 }
 
+// USL with linear shapes: light nodes (m_L = 0.5 m_p at cfl 0.5), whose
+// left-out force pass B moves where it sticks the pair and the supports
+// take where they fix an axis (kernels/mm_left_out.hpp, light_nodes.hpp);
+// the bodies start a quarter cell off the grid lines, so light nodes lie
+// along the interface, the fixed bottom and the loaded top.
+TEST(Determinism, ImperfectInterfaceUslLinearLightNodes2D) {
+  BoxScene2D s = two_materials("double", kPerfectNormalInterface);
+  s.shape = "linear";
+  s.b0_min[1] = s.b1_min[1] = 4.25;
+  s.b0_max[1] = s.b1_max[1] = 84.25;
+  s.b0_min[0] = 4.25;
+  s.b1_max[0] = 64.25;
+  s.b0_max[0] = s.b1_min[0] = 34.25;
+  s.extra +=
+      "[[boundary]]\nwhere = { min = [-1.0, -1.0], max = [200.0, 4.5] }\nfix = [\"x\", \"y\"]\n\n"
+      "[[load]]\nkind = \"traction\"\nwhere = { body = \"left\", face = \"y_max\" }\n"
+      "traction = [0.5, -2.0]\nramp = 0.004\n\n"
+      "[[load]]\nkind = \"gravity\"\nacceleration = [0.0, -10.0]\n";
+  const RunResult r = check_scene(s.text(), "2D linear double", 40.0);
+  EXPECT_GE(r.counters.multimaterial_nodes, long(kParallelNodes));
+  EXPECT_GT(r.energies.interface, 0.0);
+}
+
 TEST(Determinism, ImperfectInterfaceNumericDnMUSL2D) {
   BoxScene2D s = two_materials("double", kNumericInterface);
   s.scheme = "MUSL";

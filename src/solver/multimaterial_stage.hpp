@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <limits>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "io/checkpoint.hpp"
@@ -94,6 +95,26 @@ class MultimaterialStage {
     usf_ = scene.simulation.scheme == Scheme::USF;
     if (const char* why = validate_multimaterial(grid, cfg_))
       throw InputError(scene.source_file + ": multimaterial setup: " + why);
+  }
+
+  // USL's light-node masses m_L per field (Stepper::set_usl_light_thresholds;
+  // empty: MUSL, USF): pass B after the update moves a light field's
+  // left-out force where it sticks the pair (kernels/mm_left_out.hpp).
+  // fixed_axes: per node, bit d where a support fixes axis d (or empty).
+  void set_light_nodes(const std::vector<double>& light_mass,
+                       std::vector<unsigned char> fixed_axes) {
+    light_mass_.assign(light_mass.begin(), light_mass.end());
+    light_fixed_ = std::move(fixed_axes);
+  }
+  // Before pass B after the update: the step's gravity (which the update
+  // scaled with a light node's force) and the grid's dvel (where the update
+  // left the rest). Set every step, as the pointers follow the Stepper's
+  // own arrays.
+  void set_light_step(const std::array<double, 3>& gravity, const std::array<Real*, D>& dvel) {
+    cfg_.light_mass = light_mass_.empty() ? nullptr : light_mass_.data();
+    cfg_.light_dvel = dvel;
+    cfg_.light_fixed = light_fixed_.empty() ? nullptr : light_fixed_.data();
+    for (int d = 0; d < 3; ++d) cfg_.light_gravity[std::size_t(d)] = Real(gravity[std::size_t(d)]);
   }
 
   bool has_interface_forces() const { return enabled_ && has_interface_; }
@@ -200,6 +221,8 @@ class MultimaterialStage {
   std::vector<int> pair_;
   std::vector<unsigned char> rigid_;
   std::vector<PairParams<Real>> params_;
+  std::vector<Real> light_mass_;            // per field, USL only (set_light_nodes)
+  std::vector<unsigned char> light_fixed_;  // per node, USL with supports only
   MMConfig<D, Real> cfg_;
   MMStats stats_;
   std::vector<std::uint32_t> list_;

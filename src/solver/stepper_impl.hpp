@@ -42,6 +42,18 @@ Stepper<D, Shape, Real>::Stepper(const Scene& scene) : scene_(scene), plan_(plan
   setup_particles(make_particles(scene));
   setup_mirrors();
   mm_.setup(scene, plan_, G_, Real(min_particle_mass_), dt_);
+  {
+    // Which axes the supports fix at each node, for pass B's left-out exchange.
+    std::vector<unsigned char> fixed;
+    if (!usl_light_threshold_.empty() && plan_.multimaterial && !boundaries_.empty()) {
+      fixed.assign(G_.nodes, 0);
+      for (const BoundaryNodes& bc : boundaries_)
+        for (const std::uint32_t node : bc.nodes)
+          for (int d = 0; d < D; ++d)
+            if (bc.fix[d]) fixed[node] |= (unsigned char)(1u << d);
+    }
+    mm_.set_light_nodes(usl_light_threshold_, std::move(fixed));
+  }
   support_views_.resize(boundaries_.size());
   support_terms_.resize(boundaries_.size());
   for (std::size_t b = 0; b < boundaries_.size(); ++b)
@@ -891,6 +903,10 @@ Supports<Real> Stepper<D, Shape, Real>::supports(bool with_dvel) {
   s.mass_threshold = mass_threshold_;
   s.dt = dt_;
   s.with_dvel = with_dvel;
+  if (with_dvel && !usl_light_threshold_.empty()) {
+    s.light = usl_light_threshold_.data();
+    for (int d = 0; d < 3; ++d) s.gravity[d] = Real(gravity_[std::size_t(d)]);
+  }
   return s;
 }
 
@@ -1221,6 +1237,7 @@ void Stepper<D, Shape, Real>::step() {
   toc(kStageGrid);
   if (mm) {
     tic();
+    mm_.set_light_step(gravity_, GV_.dvel);
     mm_.pass_b(G_, own_);
     add_rigid_work();
     toc(kStageMultimaterial);
