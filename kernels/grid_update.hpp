@@ -123,8 +123,9 @@ template <int D, class Real, bool Interface, bool Damping, bool Velocities, bool
       if constexpr (Interface) force += fi_[d][n], damped += fi_[d][n] * keep;
       const Real sliver = some ? dt * force / m : Real(0);
       const Real updated = std::fma(dt, damped, p);
-      // The light node's force left out of the momentum, for dvel: 0 elsewhere
-      // (left_out_velocity, kernels/mm_left_out.hpp, forms it again for pass B).
+      // The light node's force left out of the momentum, for dvel: 0 elsewhere.
+      // light_left_out (kernels/light_nodes.hpp) forms it again for the
+      // supports and pass B: change both together.
       const Real left_out = dt * force * (Real(1) - keep) * inv_m;
       if constexpr (Velocities) {
         // grid_velocities' formulas on the updated momentum.
