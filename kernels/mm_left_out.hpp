@@ -1,5 +1,5 @@
-// USL's light nodes at a pair that pass B sticks (docs/validation.md §3.5,
-// "A stuck pair's left-out force").
+// USL's light nodes at a pair that pass B holds (docs/validation.md §3.5,
+// "The whole force, and where it is held" and "Sliding pairs").
 //
 // Under USL a field lighter than m_L at a node takes only f m / m_L of its
 // force into the momentum (update_deformable, kernels/grid_update.hpp); the
@@ -21,10 +21,13 @@
 // rest goes to both fields' dvel as one velocity over M. A rigid partner
 // absorbs the light field's left-out impulse along the stuck directions (its
 // reaction takes it). The particles' total momentum change is unchanged.
+// A pair pass B lets slide (Coulomb) is held along its normal only, with
+// the friction that normal impulse carries (exchange_left_out below).
 #pragma once
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstddef>
 
 #include "kernels/grid_view.hpp"
@@ -48,14 +51,30 @@ inline unsigned char stuck_directions(Law law, unsigned char pass_a_flags, bool 
     return (unsigned char)((normal ? kStickNormal : 0) | (tangential ? kStickTangential : 0));
   }
   // Contact: held sticks the normal; stuck (stick, Coulomb inside its cone)
-  // the tangential too. A sliding Coulomb pair is left alone: its friction
-  // is capped by pass B's normal impulse, which the left-out normal force
-  // would have added to. Exchanged apart from it, the left-out part held
-  // the block on incline_block.toml without its friction (USL, linear: a
-  // +0.17 % at cfl 0.5, +0.52 % at 0.7; left in dvel it returns through the
-  // next step's contact, and a reads 65.359 against 65.359 exact).
-  if (!held || (law == Law::friction && !stuck)) return 0;
+  // the tangential too. A sliding Coulomb pair is held along the normal only
+  // (exchange_left_out adds the friction that the exchanged normal impulse
+  // carries).
+  if (!held) return 0;
   return stuck ? kStickBoth : kStickNormal;
+}
+
+// How pass B held a pair, for exchange_left_out: the stuck directions, and
+// for a sliding Coulomb pair its friction coefficient.
+template <class Real>
+struct PassBHold {
+  unsigned char directions = 0;  // kStick* bits (stuck_directions)
+  bool sliding = false;          // Coulomb, held but not stuck
+  Real friction = 0;             // its mu
+};
+
+template <class Real>
+PassBHold<Real> pass_b_hold(Law law, Real friction, unsigned char pass_a_flags, bool held,
+                            bool stuck) {
+  PassBHold<Real> hold;
+  hold.directions = stuck_directions(law, pass_a_flags, held, stuck);
+  hold.sliding = law == Law::friction && held && !stuck;
+  hold.friction = hold.sliding ? friction : Real(0);
+  return hold;
 }
 
 template <int D, class Real>
@@ -66,41 +85,72 @@ VecD<D, Real> left_out_velocity(const GridView<D, Real>& grid, std::size_t i, Re
   return v;
 }
 
-// The exchange above at `node` for the pair (fa, fb) that pass B stuck along
-// `directions` (stuck_directions) about the unit normal n. Writes grid.p and
+// The exchange above at `node` for the pair (fa, fb) that pass B held as
+// `hold` says (pass_b_hold) about the unit normal n. Writes grid.p and
 // dvel; returns the momentum change a rigid fb takes from a (for its
 // reaction; zero for a deformable fb). `fixed` (bit d: a support fixes axis
 // d at the node) leaves those components alone: the support then takes
 // each field's own left-out velocity there (apply_supports), and with this
 // exchange too it took it twice (a particle-velocity mode where the
 // two-layer interface meets its fixed bottom).
+//
+// A sliding Coulomb pair (docs/validation.md §3.5, "Sliding pairs") is
+// exchanged along the normal only, and only where the left-out velocities
+// press the pair together (contact does not pull): that adds the normal
+// impulse J = m_r ((v'_a − v'_b)·n), m_r = m_a m_b / M (m_a for a rigid b),
+// to the one pass B applied, and with it the friction μ J, against the
+// pair's tangential sliding (kept plus left-out), capped where that sliding
+// would stop. The friction goes to dvel, where the left-out part lives:
+// applied to a light field's momentum it would move the velocity its strain
+// reads. Left without it, the normal impulse held the block on
+// incline_block.toml with no friction for it (a +0.17 % at cfl 0.5); left
+// out altogether, the block on rotated_incline.toml slid with too little
+// friction (K +25 % at cfl 0.65).
 template <int D, class Real>
 VecD<D, Real> exchange_left_out(GridView<D, Real>& grid, const Real* light_mass,
                                 const std::array<Real*, D>& dvel,
                                 const std::array<Real, 3>& gravity, Real dt, std::size_t node,
-                                int fa, int fb, bool b_rigid, unsigned char directions,
+                                int fa, int fb, bool b_rigid, const PassBHold<Real>& hold,
                                 const VecD<D, Real>& n, unsigned char fixed) {
+  using namespace mm_detail;
   VecD<D, Real> absorbed{};
   // No normal: pass B left the pair alone.
-  if (directions == 0 || mm_detail::dot<D, Real>(n, n) == Real(0)) return absorbed;
+  if (hold.directions == 0 || dot<D, Real>(n, n) == Real(0)) return absorbed;
   const std::size_t ia = grid.at(fa, node), ib = grid.at(fb, node);
   const Real ma = grid.m[ia], mb = grid.m[ib];
   const Real la = light_mass[fa], lb = b_rigid ? Real(0) : light_mass[fb];
   const bool a_light = ma <= la, b_light = !b_rigid && mb <= lb;
   if (!a_light && !b_light) return absorbed;
+  const VecD<D, Real> full_a = left_out_velocity<D, Real>(grid, ia, ma, la, gravity, dt);
+  const VecD<D, Real> full_b =
+      b_rigid ? VecD<D, Real>{} : left_out_velocity<D, Real>(grid, ib, mb, lb, gravity, dt);
+  VecD<D, Real> friction{};  // the sliding pair's friction impulse on a
+  if (hold.sliding) {
+    const VecD<D, Real> parting = add_scaled<D, Real>(full_a, full_b, Real(-1));
+    const Real approach = dot<D, Real>(parting, n);
+    if (!(approach > Real(0))) return absorbed;
+    const Real m_r = b_rigid ? ma : ma * mb / (ma + mb);
+    VecD<D, Real> slide;  // a's tangential velocity relative to b, kept plus left-out
+    for (int d = 0; d < D; ++d) slide[d] = grid.p[d][ia] / ma - grid.p[d][ib] / mb + parting[d];
+    slide = add_scaled<D, Real>(slide, n, -dot<D, Real>(slide, n));
+    const Real speed = std::sqrt(dot<D, Real>(slide, slide));
+    if (speed > Real(0))
+      friction =
+          scaled<D, Real>(slide, -std::min(hold.friction * m_r * approach, m_r * speed) / speed);
+  }
   auto along = [&](const VecD<D, Real>& v) {
-    return directional_stick_change<D, Real>(directions, v, n);
+    return directional_stick_change<D, Real>(hold.directions, v, n);
   };
-  const VecD<D, Real> lo_a = along(left_out_velocity<D, Real>(grid, ia, ma, la, gravity, dt));
+  const VecD<D, Real> lo_a = along(full_a);
   if (b_rigid) {
     for (int d = 0; d < D; ++d) {
       if ((fixed >> d) & 1u) continue;
-      dvel[d][ia] -= lo_a[d];
-      absorbed[d] = -ma * lo_a[d];
+      dvel[d][ia] += friction[d] / ma - lo_a[d];
+      absorbed[d] = friction[d] - ma * lo_a[d];
     }
     return absorbed;
   }
-  const VecD<D, Real> lo_b = along(left_out_velocity<D, Real>(grid, ib, mb, lb, gravity, dt));
+  const VecD<D, Real> lo_b = along(full_b);
   const Real total = ma + mb;
   const Real rho_a = a_light && ma < la ? std::min(Real(1), mb / (la - ma)) : Real(0);
   const Real rho_b = b_light && mb < lb ? std::min(Real(1), ma / (lb - mb)) : Real(0);
@@ -112,8 +162,8 @@ VecD<D, Real> exchange_left_out(GridView<D, Real>& grid, const Real* light_mass,
     const Real shared = ((ja - rho_a * ja) + (jb - rho_b * jb)) * inv_total;
     grid.p[d][ia] += ma * inv_total * restored;
     grid.p[d][ib] += mb * inv_total * restored;
-    dvel[d][ia] += shared - lo_a[d];
-    dvel[d][ib] += shared - lo_b[d];
+    dvel[d][ia] += shared - lo_a[d] + friction[d] / ma;
+    dvel[d][ib] += shared - lo_b[d] - friction[d] / mb;
   }
   return absorbed;
 }

@@ -696,7 +696,7 @@ void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::si
       if (cfg.light_mass) {  // USL: a light field's left-out force where the pair stuck
         const VecD<D, Real> taken = exchange_left_out<D, Real>(
             grid, cfg.light_mass, cfg.light_dvel, cfg.light_gravity, cfg.dt, node, fa, fb, b_rigid,
-            stuck_directions(pp->law, flags_in[slot], r.held, r.stuck), r.normal,
+            pass_b_hold(pp->law, pp->friction, flags_in[slot], r.held, r.stuck), r.normal,
             cfg.light_fixed ? cfg.light_fixed[node] : 0);
         if (b_rigid) add_reaction<D, Real>(cs, fb, taken, VecD<D, Real>{}, inv_dt);
       }
@@ -754,8 +754,9 @@ void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::si
       if (cfg.light_mass && b_rigid) {
         const VecD<D, Real> taken = exchange_left_out<D, Real>(
             grid, cfg.light_mass, cfg.light_dvel, cfg.light_gravity, cfg.dt, node, fa,
-            nf.field[partner], true, stuck_directions(pp.law, flags_in[slot], r.held, r.stuck),
-            r.normal, cfg.light_fixed ? cfg.light_fixed[node] : 0);
+            nf.field[partner], true,
+            pass_b_hold(pp.law, pp.friction, flags_in[slot], r.held, r.stuck), r.normal,
+            cfg.light_fixed ? cfg.light_fixed[node] : 0);
         add_reaction<D, Real>(cs, nf.field[partner], taken, VecD<D, Real>{}, inv_dt);
       }
     }
@@ -938,10 +939,11 @@ void process_chunk(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg,
       if (cfg.light_mass) {  // as process_node
         VecD<D, Real> n;
         for (int d = 0; d < D; ++d) n[d] = B.n[d][i];
-        exchange_left_out<D, Real>(grid, cfg.light_mass, cfg.light_dvel, cfg.light_gravity, cfg.dt,
-                                   node, B.field_a, B.field_b, false,
-                                   stuck_directions(B.params->law, B.stick[i], held, stuck), n,
-                                   cfg.light_fixed ? cfg.light_fixed[node] : 0);
+        exchange_left_out<D, Real>(
+            grid, cfg.light_mass, cfg.light_dvel, cfg.light_gravity, cfg.dt, node, B.field_a,
+            B.field_b, false,
+            pass_b_hold(B.params->law, B.params->friction, B.stick[i], held, stuck), n,
+            cfg.light_fixed ? cfg.light_fixed[node] : 0);
       }
     }
     if constexpr (kPassA) {

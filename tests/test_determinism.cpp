@@ -243,8 +243,10 @@ TEST(Determinism, ImperfectInterfacePerfectNormal2D) {
 // take where they fix an axis (kernels/mm_left_out.hpp, light_nodes.hpp);
 // the bodies start a quarter cell off the grid lines, so light nodes lie
 // along the interface, the fixed bottom and the loaded top.
-TEST(Determinism, ImperfectInterfaceUslLinearLightNodes2D) {
-  BoxScene2D s = two_materials("double", kPerfectNormalInterface);
+// The two bodies above, a quarter cell off the grid lines, a fixed bottom,
+// the left one pushed right and down by traction and gravity.
+BoxScene2D usl_linear_light_nodes(const char* interaction) {
+  BoxScene2D s = two_materials("double", interaction);
   s.shape = "linear";
   s.b0_min[1] = s.b1_min[1] = 4.25;
   s.b0_max[1] = s.b1_max[1] = 84.25;
@@ -256,9 +258,28 @@ TEST(Determinism, ImperfectInterfaceUslLinearLightNodes2D) {
       "[[load]]\nkind = \"traction\"\nwhere = { body = \"left\", face = \"y_max\" }\n"
       "traction = [0.5, -2.0]\nramp = 0.004\n\n"
       "[[load]]\nkind = \"gravity\"\nacceleration = [0.0, -10.0]\n";
-  const RunResult r = check_scene(s.text(), "2D linear double", 40.0);
+  return s;
+}
+
+TEST(Determinism, ImperfectInterfaceUslLinearLightNodes2D) {
+  const RunResult r =
+      check_scene(usl_linear_light_nodes(kPerfectNormalInterface).text(), "2D linear double", 40.0);
   EXPECT_GE(r.counters.multimaterial_nodes, long(kParallelNodes));
   EXPECT_GT(r.energies.interface, 0.0);
+}
+
+// The same bodies in Coulomb contact, pressed together and sliding past
+// each other (relative velocity 10 mm/ms into the face, 20 along it): pass
+// B's sliding pairs exchange the light nodes' left-out normal force with its
+// friction (exchange_left_out): 512-1023 exchanges over the runs at cfl 0.7
+// (counted with a temporary print).
+TEST(Determinism, FrictionContactUslLinearSlidingLightNodes2D) {
+  BoxScene2D s = usl_linear_light_nodes(kFrictionContact);
+  s.b0_vel[0] = 5.0, s.b0_vel[1] = -10.0;
+  s.b1_vel[0] = -5.0, s.b1_vel[1] = 10.0;
+  s.cfl = 0.7;  // m_L = 0.98 m_p: more light nodes
+  const RunResult r = check_scene(s.text(), "2D linear double", 40.0);
+  EXPECT_GE(r.counters.multimaterial_nodes, long(kParallelNodes));
 }
 
 TEST(Determinism, ImperfectInterfaceNumericDnMUSL2D) {

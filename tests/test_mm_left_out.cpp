@@ -50,7 +50,18 @@ struct LightNode {
   VecD<2, double> exchange(unsigned char directions, VecD<2, double> n, bool b_rigid = false,
                            unsigned char fixed = 0) {
     return exchange_left_out<2, double>(grid.view, light.data(), dvel_ptr, gravity, kDt, 0, 0, 1,
-                                        b_rigid, directions, n, fixed);
+                                        b_rigid, PassBHold<double>{directions, false, 0.0}, n,
+                                        fixed);
+  }
+  // pass B held the pair sliding under Coulomb friction mu.
+  VecD<2, double> slide(double mu, VecD<2, double> n, bool b_rigid = false) {
+    return exchange_left_out<2, double>(grid.view, light.data(), dvel_ptr, gravity, kDt, 0, 0, 1,
+                                        b_rigid, PassBHold<double>{kStickNormal, true, mu}, n, 0);
+  }
+  // Field x's velocity as its particles receive it: p / m plus dvel.
+  double total_velocity(int x, int d) const {
+    const std::size_t i = std::size_t(x);
+    return grid.p[d][i] / grid.m[i] + dvel[d][i];
   }
 };
 
@@ -149,6 +160,63 @@ TEST(LightNodeExchange, FixedAxisIsLeftToTheSupport) {
   EXPECT_NEAR(node.dvel[1][0], 0.0, 1e-14) << "the free axis is exchanged";
 }
 
+// A sliding Coulomb pair against a rigid floor below it (n = a -> b = -y):
+// a's left-out velocity presses it into the floor, so the floor takes that
+// normal part, and with it the friction mu m_a (v'_a . n) against a's
+// sliding (kept +x 1.5 plus left-out), in dvel; the reaction counts both.
+TEST(LightNodeExchange, SlidingPairTakesTheNormalPartAndItsFriction) {
+  const double mu = 0.5, ma = 0.1;
+  LightNode node(ma, 2.0, 0.5, 0.5);
+  node.grid.p[0][0] = ma * 2.0;  // a slides along +x at 1.5 relative to the floor
+  const double lo[2] = {node.dvel[0][0], node.dvel[1][0]};
+  ASSERT_LT(lo[1], 0.0) << "the left-out part must press a into the floor";
+  const double p_before[2] = {node.grid.p[0][0], node.grid.p[1][0]};
+  const VecD<2, double> absorbed = node.slide(mu, {0.0, -1.0}, true);
+  EXPECT_NEAR(node.dvel[1][0], 0.0, 1e-15) << "the floor holds the normal part";
+  EXPECT_NEAR(node.dvel[0][0], lo[0] - mu * (-lo[1]), 1e-15) << "friction mu |v'_n|";
+  for (int d = 0; d < 2; ++d) {
+    EXPECT_EQ(node.grid.p[d][0], p_before[d]) << "the momentum (strain, positions) is not touched";
+    EXPECT_NEAR(absorbed[d], ma * (node.dvel[d][0] - lo[d]), 1e-16);
+  }
+  // A large mu stops the sliding, kept and left-out together, and no more.
+  LightNode stuck(ma, 2.0, 0.5, 0.5);
+  stuck.grid.p[0][0] = ma * 2.0;
+  stuck.slide(100.0, {0.0, -1.0}, true);
+  EXPECT_NEAR(stuck.total_velocity(0, 0), stuck.grid.velocity(1, 0, 0), 1e-14);
+  // A left-out part that pulls a off the floor is not held (contact does not
+  // pull), and carries no friction.
+  LightNode parting(ma, 2.0, 0.5, 0.5);
+  const double before[2] = {parting.dvel[0][0], parting.dvel[1][0]};
+  const VecD<2, double> none = parting.slide(mu, {0.0, 1.0}, true);
+  for (int d = 0; d < 2; ++d) {
+    EXPECT_EQ(parting.dvel[d][0], before[d]);
+    EXPECT_EQ(none[d], 0.0);
+  }
+}
+
+// Two light deformable fields sliding on each other: the pair is one node
+// along the normal (as a frictionless held pair), the exchanged normal
+// impulse J = m_r (v'_a - v'_b) . n carries the friction mu J, a gets it and
+// b its negative: the momentum is kept, the normal left-out velocities end
+// equal, and the relative sliding drops by mu J (1 / m_a + 1 / m_b).
+TEST(LightNodeExchange, SlidingDeformablePairExchangesTheNormalAndItsFriction) {
+  const double mu = 0.3, ma = 0.1, mb = 0.2;
+  LightNode node(ma, mb, 0.5, 0.5);
+  node.grid.p[0][0] = ma * 2.0;  // a slides along +x at 1.5 relative to b
+  const VecD<2, double> n{0.0, -1.0};
+  const double approach = -(node.dvel[1][0] - node.dvel[1][1]);
+  ASSERT_GT(approach, 0.0);
+  const double before[2] = {node.momentum(0), node.momentum(1)};
+  const double slide_before = node.total_velocity(0, 0) - node.total_velocity(1, 0);
+  const double normal_kept = node.grid.velocity(0, 0, 1) - node.grid.velocity(1, 0, 1);
+  node.slide(mu, n);
+  for (int d = 0; d < 2; ++d) EXPECT_NEAR(node.momentum(d), before[d], 1e-14);
+  EXPECT_NEAR(node.total_velocity(0, 1) - node.total_velocity(1, 1), normal_kept, 1e-14);
+  const double J = ma * mb / (ma + mb) * approach;
+  EXPECT_NEAR(node.total_velocity(0, 0) - node.total_velocity(1, 0),
+              slide_before - mu * J * (1 / ma + 1 / mb), 1e-14);
+}
+
 TEST(LightNodeExchange, StuckDirectionsFollowTheLawAndPassB) {
   EXPECT_EQ(stuck_directions(Law::interface, kStickNormal, false, false), kStickNormal);
   EXPECT_EQ(stuck_directions(Law::interface, kStickTangential, false, false), kStickTangential);
@@ -159,8 +227,11 @@ TEST(LightNodeExchange, StuckDirectionsFollowTheLawAndPassB) {
   EXPECT_EQ(stuck_directions(Law::interface, one_sided, true, false), kStickBoth);
   EXPECT_EQ(stuck_directions(Law::interface, one_sided, false, false), kStickTangential);
   EXPECT_EQ(stuck_directions(Law::frictionless, 0, true, false), kStickNormal);
-  // A sliding Coulomb pair: its friction reads pass B's normal impulse.
-  EXPECT_EQ(stuck_directions(Law::friction, 0, true, false), 0) << "sliding";
+  // A sliding Coulomb pair is held along the normal (with its friction).
+  EXPECT_EQ(stuck_directions(Law::friction, 0, true, false), kStickNormal) << "sliding";
+  EXPECT_TRUE((pass_b_hold<double>(Law::friction, 0.3, 0, true, false).sliding));
+  EXPECT_FALSE((pass_b_hold<double>(Law::friction, 0.3, 0, true, true).sliding));
+  EXPECT_FALSE((pass_b_hold<double>(Law::frictionless, 0.0, 0, true, false).sliding));
   EXPECT_EQ(stuck_directions(Law::friction, 0, true, true), kStickBoth);
   EXPECT_EQ(stuck_directions(Law::stick, 0, true, true), kStickBoth);
   EXPECT_EQ(stuck_directions(Law::stick, 0, false, false), 0);
