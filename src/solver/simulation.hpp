@@ -112,9 +112,10 @@ double stable_time_step(const Scene& scene);
 double critical_time_step(const Scene& scene);  // the same with cfl = 1
 double damping_time_step(const Scene& scene);   // 2 / grid.damping (its own limit)
 double fastest_wave_speed(const Scene& scene);  // the materials' fastest dilatational wave
-// The largest cfl at which USL ran the bars of docs/validation.md §3.5
-// stable, per shape (1.0 for the cubic B-spline: MUSL's and USF's bound).
-double usl_cfl_limit(ShapeKind shape);
+// The largest cfl at which USL ran the bars and sliding blocks of
+// docs/validation.md §3.5 stable, per shape and dimension (1.0 for the
+// cubic B-spline in 2D: MUSL's and USF's bound).
+double usl_cfl_limit(ShapeKind shape, int dimension);
 // `run` and `check`: a warning (one line, empty if none) when scheme = "USL"
 // takes a step above usl_cfl_limit.
 std::string usl_time_step_warning(const Scene& scene, double dt);
