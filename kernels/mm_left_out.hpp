@@ -99,13 +99,14 @@ VecD<D, Real> left_out_velocity(const GridView<D, Real>& grid, std::size_t i, Re
 // press the pair together (contact does not pull): that adds the normal
 // impulse J = m_r ((v'_a − v'_b)·n), m_r = m_a m_b / M (m_a for a rigid b),
 // to the one pass B applied, and with it the friction μ J, against the
-// pair's tangential sliding (kept plus left-out), capped where that sliding
-// would stop. The friction goes to dvel, where the left-out part lives:
-// applied to a light field's momentum it would move the velocity its strain
-// reads. Left without it, the normal impulse held the block on
-// incline_block.toml with no friction for it (a +0.17 % at cfl 0.5); left
-// out altogether, the block on rotated_incline.toml slid with too little
-// friction (K +25 % at cfl 0.65).
+// pair's tangential sliding (kept, read from the momenta after pass B's
+// change, plus left-out), capped where that sliding would stop. The
+// friction goes to dvel, where the left-out part lives: applied to a light
+// field's momentum it would move the velocity its strain reads. Left
+// without it, the normal impulse held the block on incline_block.toml with
+// no friction for it (a +0.17 % at cfl 0.5); left out altogether, the
+// block on rotated_incline.toml slid with too little friction (K +25 % at
+// cfl 0.65).
 template <int D, class Real>
 VecD<D, Real> exchange_left_out(GridView<D, Real>& grid, const Real* light_mass,
                                 const std::array<Real*, D>& dvel,
@@ -126,12 +127,12 @@ VecD<D, Real> exchange_left_out(GridView<D, Real>& grid, const Real* light_mass,
       b_rigid ? VecD<D, Real>{} : left_out_velocity<D, Real>(grid, ib, mb, lb, gravity, dt);
   VecD<D, Real> friction{};  // the sliding pair's friction impulse on a
   if (hold.sliding) {
-    const VecD<D, Real> parting = add_scaled<D, Real>(full_a, full_b, Real(-1));
-    const Real approach = dot<D, Real>(parting, n);
+    const VecD<D, Real> relative = add_scaled<D, Real>(full_a, full_b, Real(-1));
+    const Real approach = dot<D, Real>(relative, n);
     if (!(approach > Real(0))) return absorbed;
     const Real m_r = b_rigid ? ma : ma * mb / (ma + mb);
     VecD<D, Real> slide;  // a's tangential velocity relative to b, kept plus left-out
-    for (int d = 0; d < D; ++d) slide[d] = grid.p[d][ia] / ma - grid.p[d][ib] / mb + parting[d];
+    for (int d = 0; d < D; ++d) slide[d] = grid.p[d][ia] / ma - grid.p[d][ib] / mb + relative[d];
     slide = add_scaled<D, Real>(slide, n, -dot<D, Real>(slide, n));
     const Real speed = std::sqrt(dot<D, Real>(slide, slide));
     if (speed > Real(0))

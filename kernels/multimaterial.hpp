@@ -707,8 +707,15 @@ void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::si
   // §6, three or more materials: each deformable a against the lump of its partners
   // (or against its rigid partner), all computed from the gathered snapshot, applied after.
   VecD<D, Real> change[kMaxFields], force[kMaxFields];
+  // Pass B under USL: how each field was held against its rigid partner, for
+  // the left-out exchange once the changes are applied (a sliding pair's
+  // friction reads the updated momenta).
+  PassBHold<Real> hold[kMaxFields];
+  VecD<D, Real> held_normal[kMaxFields];
+  int rigid_partner[kMaxFields];
   bool lumped_energy_counted = false;
   for (int ia = 0; ia < K; ++ia) {
+    rigid_partner[ia] = -1;
     change[ia] = VecD<D, Real>{};
     force[ia] = VecD<D, Real>{};
     const int fa = nf.field[ia];
@@ -748,20 +755,27 @@ void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::si
     } else {
       const std::size_t slot = k * std::size_t(F) + std::size_t(fa);
       record_held(flags_out, slot, r.held, r.stuck);
-      // USL's left-out force against a rigid partner (which changes dvel and
-      // the reaction only). Against a lump of deformable partners it is left
-      // in dvel: the lump's fields do not share one stuck velocity.
+      // USL's left-out force against a rigid partner, below. Against a lump
+      // of deformable partners it is left in dvel: the lump's fields do not
+      // share one stuck velocity.
       if (cfg.light_mass && b_rigid) {
-        const VecD<D, Real> taken = exchange_left_out<D, Real>(
-            grid, cfg.light_mass, cfg.light_dvel, cfg.light_gravity, cfg.dt, node, fa,
-            nf.field[partner], true,
-            pass_b_hold(pp.law, pp.friction, flags_in[slot], r.held, r.stuck), r.normal,
-            cfg.light_fixed ? cfg.light_fixed[node] : 0);
-        add_reaction<D, Real>(cs, nf.field[partner], taken, VecD<D, Real>{}, inv_dt);
+        rigid_partner[ia] = nf.field[partner];
+        hold[ia] = pass_b_hold(pp.law, pp.friction, flags_in[slot], r.held, r.stuck);
+        held_normal[ia] = r.normal;
       }
     }
   }
   for (int ia = 0; ia < K; ++ia) apply(nf.field[ia], change[ia], force[ia], Real(1));
+  if constexpr (!kPassA) {
+    for (int ia = 0; ia < K; ++ia) {
+      if (rigid_partner[ia] < 0) continue;
+      const VecD<D, Real> taken =
+          exchange_left_out<D, Real>(grid, cfg.light_mass, cfg.light_dvel, cfg.light_gravity,
+                                     cfg.dt, node, nf.field[ia], rigid_partner[ia], true, hold[ia],
+                                     held_normal[ia], cfg.light_fixed ? cfg.light_fixed[node] : 0);
+      add_reaction<D, Real>(cs, rigid_partner[ia], taken, VecD<D, Real>{}, inv_dt);
+    }
+  }
 }
 
 // Which entries of [begin, end) go into the batch B: two-material nodes of
