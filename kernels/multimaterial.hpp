@@ -693,7 +693,7 @@ void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::si
     } else {
       const std::size_t slot = k * std::size_t(F) + std::size_t(fa);
       record_held(flags_out, slot, r.held, r.stuck);
-      if (cfg.light_mass) {  // USL: a light field's left-out force where the pair stuck
+      if (cfg.light_mass) {  // USL: a light field's left-out force where pass B held the pair
         const VecD<D, Real> taken = exchange_left_out<D, Real>(
             grid, cfg.light_mass, cfg.light_dvel, cfg.light_gravity, cfg.dt, node, fa, fb, b_rigid,
             pass_b_hold(pp->law, pp->friction, flags_in[slot], r.held, r.stuck), r.normal,

@@ -92,9 +92,9 @@ double fastest_wave_speed(const Scene& scene) {
 // inputs/rotated_incline.toml (rigid or elastic floor) runs at 0.72 and
 // grows at 0.75 (K + U 13 times the work done on it), hence 0.7 (0.65
 // until sliding pairs took the light nodes' left-out force, when the block
-// grew at 0.7); cubic B-splines stable
-// to 1.0. In 3D a block sliding under Coulomb friction on a rigid floor
-// (G = 200 mm/ms^2 tilted 30 degrees, h = 0.5 mm, the floor of
+// grew at 0.7); cubic B-splines stable to 1.0. In 3D a block sliding
+// under Coulomb friction on a rigid floor (G = 200 mm/ms^2 tilted 30
+// degrees, h = 0.5 mm, the floor of
 // ValidationContact.Block3DSlidesAlongASlantOfTheFloor) lowers two of
 // these: linear shapes ran it at 0.55, were off by +0.15 % in a at 0.6 and
 // grew at 0.65 (as uGIMP does); cubic B-splines ran it at 0.95 and grew at
