@@ -342,7 +342,23 @@ struct InclineRun {
   double slide = 0;             // centre-of-mass displacement along the slope at the end
   double sink = 0;              // largest downward centre-of-mass displacement
   double reaction[2] = {0, 0};  // mean force on the rigid floor over the fit window
+  double mode = 0;              // velocity_mode_ratio at the end
 };
+
+// Kinetic energy of material `body`'s particles about their centre-of-mass
+// velocity, over the bulk 1/2 M |v_cm|^2: a velocity mode that the body's
+// sliding does not explain.
+double velocity_mode_ratio(const Simulation& sim, std::size_t materials, int body = 0) {
+  const BodyState b = body_states(sim, materials)[std::size_t(body)];
+  const auto v = field(sim, "velocity"), m = field(sim, "mass"), mat = field(sim, "material");
+  double internal = 0;
+  for (std::size_t p = 0; p < sim.particle_count(); ++p)
+    if (mat.at(p) == body) {
+      const double dx = v.at(p, 0) - b.vx, dy = v.at(p, 1) - b.vy;
+      internal += m.at(p) * (dx * dx + dy * dy);
+    }
+  return internal / (b.m * (b.vx * b.vx + b.vy * b.vy));
+}
 
 InclineRun run_incline(const std::string& file, const std::vector<std::string>& overrides,
                        double t_fit = 0.07) {
@@ -378,6 +394,7 @@ InclineRun run_incline(const std::string& file, const std::vector<std::string>& 
   r.slide = s.x - s0.x;
   r.reaction[0] = rx / double(t.size());
   r.reaction[1] = ry / double(t.size());
+  r.mode = velocity_mode_ratio(*sim, nm, body);
   note(
       "%s mu %.2f: a %.4f (sliding %.4f, rolling %.4f), alpha %.4f, slide %.5f mm, sink %.5f mm, "
       "floor reaction (%.5f, %.5f) N, m G = %.5f N",
@@ -570,10 +587,12 @@ radius   = 3.0
 particles_per_cell = 2
 )";
 
-Incline3D run_incline_3d(const std::string& body, double mu,
-                         std::vector<std::string> overrides = {}) {
-  const double G = 200.0, theta = std::numbers::pi / 6;
-  const double gt = G * std::sin(theta), gn = -G * std::cos(theta);
+constexpr double kG3D = 200.0, kTheta3D = std::numbers::pi / 6;
+
+// The settings run_incline_3d gives kFloor3D + body, then `overrides`.
+std::vector<std::string> incline_3d_settings(const std::string& body, double mu,
+                                             std::vector<std::string> overrides) {
+  const double gt = kG3D * std::sin(kTheta3D), gn = -kG3D * std::cos(kTheta3D);
   const bool ball = body == kBall3D;
   overrides.insert(overrides.begin(), {"interaction[0].friction=" + num(mu),
                                        "load[0].acceleration=[" + num(gt * kSlope3D[0]) + "," +
@@ -582,7 +601,14 @@ Incline3D run_incline_3d(const std::string& body, double mu,
                                        ball ? "material[0].E=100.0" : "material[0].E=1000.0",
                                        ball ? "interaction[0].separation=\"position\""
                                             : "interaction[0].separation=\"displacement\""});
-  auto sim = testing::make_from_text(kFloor3D + body, overrides);
+  return overrides;
+}
+
+Incline3D run_incline_3d(const std::string& body, double mu,
+                         const std::vector<std::string>& overrides = {}) {
+  const double G = kG3D, theta = kTheta3D;
+  const bool ball = body == kBall3D;
+  auto sim = testing::make_from_text(kFloor3D + body, incline_3d_settings(body, mu, overrides));
   Incline3D r;
   r.G = G, r.theta = theta;
   const Motion3D m0 = motion_3d(*sim);
@@ -662,10 +688,8 @@ TEST(ValidationContact, Block3DSlidesUnderUslAtItsLimits) {
     std::vector<std::string> above = usl;
     above.back() = "simulation.cfl=" + num(std::stod(cfl) + 0.05);
     for (const auto& [sets, warns] : {std::pair{usl, false}, std::pair{above, true}}) {
-      std::vector<std::string> all = {"grid.cells=[32,32,14]", "material[0].E=1000.0",
-                                      "interaction[0].friction=0.2"};
-      all.insert(all.end(), sets.begin(), sets.end());
-      const Scene scene = parse_scene_text(kFloor3D + kBlock3D, "block3d.toml", all);
+      const Scene scene = parse_scene_text(kFloor3D + kBlock3D, "block3d.toml",
+                                           incline_3d_settings(kBlock3D, mu, sets));
       EXPECT_EQ(!usl_time_step_warning(scene, stable_time_step(scene)).empty(), warns)
           << shape << " " << sets.back();
     }
@@ -870,21 +894,6 @@ TEST(ValidationContact, RotatedInclineOnAnElasticFloorWithGeometryNormal) {
   EXPECT_NEAR(refined / (100.0 * std::sin(th)), 1.0, 0.005) << refined;
 }
 
-// Kinetic energy of material 0's particles about their centre-of-mass
-// velocity, over the bulk 1/2 M |v_cm|^2: a velocity mode that the body's
-// sliding does not explain.
-double velocity_mode_ratio(const Simulation& sim, std::size_t materials) {
-  const BodyState b = body_states(sim, materials)[0];
-  const auto v = field(sim, "velocity"), m = field(sim, "mass"), mat = field(sim, "material");
-  double internal = 0;
-  for (std::size_t p = 0; p < sim.particle_count(); ++p)
-    if (mat.at(p) == 0) {
-      const double dx = v.at(p, 0) - b.vx, dy = v.at(p, 1) - b.vy;
-      internal += m.at(p) * (dx * dx + dy * dy);
-    }
-  return internal / (b.m * (b.vx * b.vx + b.vy * b.vy));
-}
-
 // USL with linear shapes, blocks sliding under Coulomb friction: on
 // incline_block.toml's grid-aligned rigid floor (a = G (sin 30 - 0.2 cos 30)
 // = 65.359, fitted over 0.07-0.2 ms), on rotated_incline.toml's rigid
@@ -907,20 +916,10 @@ TEST(ValidationContact, SlidingBlocksUnderUslWithLinearShapesCarryNoVelocityMode
   for (const char* cfl : {"0.5", "0.7"}) {
     const std::vector<std::string> usl = {"simulation.scheme=\"USL\"", "grid.shape=\"linear\"",
                                           std::string("simulation.cfl=") + cfl};
-    auto grid_aligned = make_simulation(parse_scene_file(input("incline_block.toml"), usl));
-    std::vector<double> t, v;
-    while (grid_aligned->time() < 0.2 - 1e-9 * grid_aligned->dt()) {
-      grid_aligned->step();
-      if (grid_aligned->time() < 0.07) continue;
-      t.push_back(grid_aligned->time());
-      v.push_back(body_states(*grid_aligned, 2)[0].vx);
-    }
-    const double exact = 200.0 * (0.5 - 0.2 * std::sqrt(3.0) / 2.0);
-    const double mode = velocity_mode_ratio(*grid_aligned, 2);
-    note("incline_block USL linear cfl %s: a %.4f (exact %.4f), mode %.2e", cfl, slope(t, v), exact,
-         mode);
-    EXPECT_NEAR(slope(t, v) / exact, 1.0, 0.005) << "cfl " << cfl;
-    EXPECT_LT(mode, 1e-4) << "cfl " << cfl;
+    const InclineRun grid_aligned = run_incline("incline_block.toml", usl);
+    note("incline_block USL linear cfl %s: mode %.2e", cfl, grid_aligned.mode);
+    EXPECT_NEAR(grid_aligned.accel / sliding_accel(grid_aligned), 1.0, 0.005) << "cfl " << cfl;
+    EXPECT_LT(grid_aligned.mode, 1e-4) << "cfl " << cfl;
 
     auto rigid = make_simulation(parse_scene_file(input("rotated_incline.toml"), usl));
     auto elastic = testing::make_from_text(rotated_incline_on_an_elastic_floor(), usl);
