@@ -26,6 +26,7 @@
 #include "kernels/reduce.hpp"
 #include "kernels/separation_extrapolation.hpp"
 #include "kernels/shape.hpp"
+#include "kernels/support_gradients.hpp"
 #include "kernels/supports.hpp"
 #include "kernels/team.hpp"
 #include "model/bodies.hpp"
@@ -284,6 +285,10 @@ class Stepper final : public Simulation {
   std::vector<Vec3> boundary_reaction_;
   std::vector<SupportView<Real>> support_views_;    // per boundary, over boundaries_' lists
   std::vector<std::vector<double>> support_terms_;  // per boundary: reaction terms
+  // Per node, bit d where a plane support normal to axis d fixes axis d;
+  // empty without such planes or multimaterial nodes
+  // (kernels/support_gradients.hpp).
+  std::vector<unsigned char> plane_axes_;
   // Supports on planes that act as mirrors, in boundary order: the ghost
   // layer past the plane and its partners on the body's side.
   struct MirrorPlane {

@@ -54,6 +54,14 @@ Stepper<D, Shape, Real>::Stepper(const Scene& scene) : scene_(scene), plan_(plan
     }
     mm_.set_light_nodes(usl_light_threshold_, std::move(fixed));
   }
+  // The symmetry planes' nodes, for the domain gradients there.
+  if (plan_.multimaterial)
+    for (const BoundaryNodes& bc : boundaries_) {
+      const int ax = bc.plane_axis;
+      if (ax < 0 || ax >= D || !bc.fix[std::size_t(ax)]) continue;
+      if (plane_axes_.empty()) plane_axes_.assign(G_.nodes, 0);
+      for (const std::uint32_t node : bc.nodes) plane_axes_[node] |= (unsigned char)(1u << ax);
+    }
   support_views_.resize(boundaries_.size());
   support_terms_.resize(boundaries_.size());
   for (std::size_t b = 0; b < boundaries_.size(); ++b)
@@ -1209,6 +1217,8 @@ void Stepper<D, Shape, Real>::step() {
       for (int d = 0; d < D; ++d) cell = std::max(cell, double(G_.h[d]));
       orient_gradients(G_, mm_.nodes(), geometry_fields_, geometry_pairs_, 0.5 * Shape::S * cell);
     }
+    if (!plane_axes_.empty())
+      drop_gradients_across_planes(G_, mm_.nodes().data(), mm_.nodes().size(), plane_axes_.data());
     mm_.pass_a(G_, dt_, regular_dt_, own_);  // 0: decide for dt_
     toc(kStageMultimaterial);
   }
