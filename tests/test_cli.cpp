@@ -741,6 +741,24 @@ TEST(Cli, BSplineInterfaceAreaWarnings) {
   EXPECT_EQ(fine.err, "") << fine.describe();
 }
 
+// docs/validation.md §3.11 (open): USF with linear shapes warns, naming the
+// scheme key; USF with uGIMP and MUSL with linear shapes do not.
+TEST(Cli, UsfWithLinearShapesWarns) {
+  const std::string scene = source_dir() + "/inputs/bar_vibration.toml";
+  const CmdResult usf = run_mmpm(
+      {"check", scene, "--set", "grid.shape=\"linear\"", "--set", "simulation.scheme=\"USF\""});
+  EXPECT_EQ(usf.exit_code, 0) << usf.describe();
+  EXPECT_TRUE(contains(usf.err, "warning: key 'simulation.scheme': \"USF\" with shape \"linear\""))
+      << usf.describe();
+  for (const std::vector<std::string>& sets :
+       {std::vector<std::string>{"grid.shape=\"gimp\"", "simulation.scheme=\"USF\""},
+        std::vector<std::string>{"grid.shape=\"linear\"", "simulation.scheme=\"MUSL\""}}) {
+    const CmdResult quiet = run_mmpm({"check", scene, "--set", sets[0], "--set", sets[1]});
+    EXPECT_EQ(quiet.exit_code, 0) << quiet.describe();
+    EXPECT_FALSE(contains(quiet.err, "simulation.scheme")) << quiet.describe();
+  }
+}
+
 // An interface between bodies that start bonded, with separation =
 // "position": the centroids' offset loads it from the first step (two_layer
 // with Dn = 1000 made 5.2 mJ from 0.0019 mJ of work in 0.01 ms), so `check`

@@ -16,7 +16,9 @@ long) runs it on every scene in inputs/.
       [--scenes inputs/a.toml ...] [--shapes linear gimp] [--schemes MUSL]
       [--precisions double] [--set KEY=VALUE ...]
 
-Writes OUT/matrix.json and OUT/matrix.md; exits 1 if a run ended badly.
+Writes OUT/matrix.json and OUT/matrix.md; exits 1 if a run ended badly,
+other than the known limitations listed in KNOWN (MMPM_KNOWN=1 counts
+those too).
 """
 import argparse
 import concurrent.futures
@@ -34,6 +36,15 @@ PRECISIONS = ["double", "float"]
 ENERGIES = ["kinetic", "strain", "interface", "external_work", "damping"]
 # A refused input: "FILE:LINE: key 'KEY': what was expected".
 LOCATED = re.compile(r"^\S+:\d+: key '[^']+': ")
+# Runs the solver does not pass yet, each with its reason (as the tests'
+# MMPM_KNOWN_LIMITATION): reported as "KNOWN" and not counted as failures
+# unless MMPM_KNOWN=1. Keyed by (scene, shape, scheme).
+KNOWN = {
+    ("hertz_disk", "linear", "USF"):
+        "USF with linear shapes goes unstable where rows of particles cross grid lines "
+        "under load (the disk's contact region by 0.55 ms; a block at rest on a support "
+        "the same, at every cfl from 0.1 to 0.5; docs/validation.md section 3.11)",
+}
 
 
 def run_one(mmpm, scene, shape, scheme, precision, out, extra):
@@ -101,12 +112,20 @@ def main():
         json.dump(rows, f, indent=1)
     with open(os.path.join(args.out, "matrix.md"), "w") as f:
         f.write(markdown(rows))
-    bad = [r for r in rows if not r["ok"]]
+    known = {}
+    if not os.environ.get("MMPM_KNOWN"):
+        for r in rows:
+            key = (os.path.splitext(os.path.basename(r["scene"]))[0], r["shape"], r["scheme"])
+            if not r["ok"] and key in KNOWN:
+                known[r["run"]] = KNOWN[key]
+    for run, why in sorted(known.items()):
+        print("KNOWN %s: %s" % (run, why))
+    bad = [r for r in rows if not r["ok"] and r["run"] not in known]
     for r in bad:
         print("FAIL %s: exit %d: %s" % (r["run"], r["exit"], r["why"]))
-    print("%d runs, %d completed, %d refused with a located message, %d failed" %
-          (len(rows), sum(r["exit"] == 0 and r["ok"] for r in rows),
-           sum(r["exit"] == 2 and r["ok"] for r in rows), len(bad)))
+    print("%d runs, %d completed, %d refused with a located message, %d known limitations, "
+          "%d failed" % (len(rows), sum(r["exit"] == 0 and r["ok"] for r in rows),
+                         sum(r["exit"] == 2 and r["ok"] for r in rows), len(known), len(bad)))
     return 1 if bad else 0
 
 
