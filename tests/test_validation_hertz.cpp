@@ -37,6 +37,34 @@ const std::vector<double>& grid_values(const io::GridSnapshot& g, const std::str
   throw std::runtime_error("no grid field " + name);
 }
 
+// A scene run to its end_time, and what the runners read of it: the
+// body's field's nodal mass and force (grid_snapshot), gravity's size along
+// the vertical axis, E* = E / (1 - nu^2) of material 0, the unresolved
+// kinetic energy over the strain energy, and the rigid floor's vertical
+// reaction.
+struct AtRest {
+  io::GridSnapshot grid;
+  std::vector<double> m, f;
+  double g = 0, e_star = 0, unresolved = 0, floor_reaction = 0;
+};
+
+AtRest run_to_rest(const Scene& scene, const std::string& material, int vertical) {
+  auto sim = make_simulation(scene);
+  testing::run_until(*sim, scene.simulation.end_time);
+  AtRest a;
+  a.g = -scene.loads.at(0).acceleration[std::size_t(vertical)];
+  const MaterialSpec& body = scene.materials.at(0);
+  a.e_star = body.E / (1.0 - body.nu * body.nu);
+  a.grid = sim->grid_snapshot({"mass", "force"});
+  a.m = grid_values(a.grid, "mass." + material);
+  a.f = grid_values(a.grid, "force." + material);
+  const Energies e = sim->energies();
+  a.unresolved = e.kinetic_unresolved / e.strain;
+  for (const Reaction& q : sim->reactions())
+    if (q.name == "rigid:floor") a.floor_reaction = q.force[std::size_t(vertical)];
+  return a;
+}
+
 // The half model: the disk cut at its centre line x = 12 and the floor
 // starting there, on a symmetry plane (a support on the grid plane x = 12
 // fixing u_x, which mirrors the disk: kernels/mirror_supports.hpp).
@@ -58,15 +86,10 @@ HertzRun run_hertz(double h, std::vector<std::string> overrides = {}, bool half 
   const Scene scene =
       half ? parse_scene_text(mmpm_test::read_text(file) + kHalfModel, file, overrides)
            : parse_scene_file(file, overrides);
-  auto sim = make_simulation(scene);
-  testing::run_until(*sim, scene.simulation.end_time);
-
-  const double g = -scene.loads.at(0).acceleration[1];
-  const MaterialSpec& disk = scene.materials.at(0);
-  const double e_star = disk.E / (1.0 - disk.nu * disk.nu);
-  const io::GridSnapshot grid = sim->grid_snapshot({"mass", "force"});
-  const std::vector<double>& m = grid_values(grid, "mass.disk");
-  const std::vector<double>& f = grid_values(grid, "force.disk");
+  const AtRest a = run_to_rest(scene, "disk", 1);
+  const io::GridSnapshot& grid = a.grid;
+  const std::vector<double>&m = a.m, &f = a.f;
+  const double g = a.g, e_star = a.e_star;
   const int nx = grid.nodes[0];
   const int row = int(std::lround((kFloorTop - grid.origin[1]) / grid.spacing[1]));
 
@@ -100,10 +123,8 @@ HertzRun run_hertz(double h, std::vector<std::string> overrides = {}, bool half 
   // through the tent S_i, whose spread sum_i S_i(x) (x_i - x)^2 averages h^2 / 6
   // over a cell (docs/contact_validation.md §19.2).
   r.half_width = 2.0 * std::sqrt(second / r.line_force - h * h / 6.0);
-  const Energies e = sim->energies();
-  r.unresolved = e.kinetic_unresolved / e.strain;
-  for (const Reaction& q : sim->reactions())
-    if (q.name == "rigid:floor") r.floor_reaction = q.force[1];
+  r.unresolved = a.unresolved;
+  r.floor_reaction = a.floor_reaction;
   std::printf(
       "[ hertz    ] h %.4g: P %.5f N, floor line %.5f, floor reaction %.5f, b %.4f "
       "(Hertz %.4f, ratio %.4f), share inside b/2 %.4f (Hertz 0.6090), unresolved KE / U %.2e\n",
@@ -153,9 +174,10 @@ double mean_width_ratio(const std::vector<HertzRun>& runs) {
 // 1.003-1.027, mean 1.019. Asserted: the mean within 25 % at h = 0.5 and within 6 % at
 // h = 0.25, and its error at h = 0.25 below half that at h = 0.5.
 TEST(ValidationHertz, DiskOnRigidFloorHalfWidthConvergesOnHertz) {
-  EXPECT_NEAR(run_hertz(0.25).hertz_width, 2.0, 0.01) << "the scene is built for b = 2 mm";
-  const double err_coarse = std::abs(mean_width_ratio(runs_over_places(0.5)) - 1.0);
-  const double err_fine = std::abs(mean_width_ratio(runs_over_places(0.25)) - 1.0);
+  const std::vector<HertzRun> coarse = runs_over_places(0.5), fine = runs_over_places(0.25);
+  EXPECT_NEAR(fine[0].hertz_width, 2.0, 0.01) << "the scene is built for b = 2 mm";
+  const double err_coarse = std::abs(mean_width_ratio(coarse) - 1.0);
+  const double err_fine = std::abs(mean_width_ratio(fine) - 1.0);
   EXPECT_LT(err_coarse, 0.25);
   EXPECT_LT(err_fine, 0.06);
   EXPECT_LT(err_fine, 0.5 * err_coarse) << "refining must bring b toward Hertz's";
@@ -203,14 +225,10 @@ HertzRun3D run_hertz_3d(double h, double end_time) {
        "grid.cells=[" + std::to_string(nxy) + "," + std::to_string(nxy) + "," + std::to_string(nz) +
            "]",
        "simulation.end_time=" + std::to_string(end_time)});
-  auto sim = make_simulation(scene);
-  testing::run_until(*sim, scene.simulation.end_time);
-  const double g = -scene.loads.at(0).acceleration[2];
-  const MaterialSpec& ball = scene.materials.at(0);
-  const double e_star = ball.E / (1.0 - ball.nu * ball.nu);
-  const io::GridSnapshot grid = sim->grid_snapshot({"mass", "force"});
-  const std::vector<double>& m = grid_values(grid, "mass.ball");
-  const std::vector<double>& f = grid_values(grid, "force.ball");
+  const AtRest a = run_to_rest(scene, "ball", 2);
+  const io::GridSnapshot& grid = a.grid;
+  const std::vector<double>&m = a.m, &f = a.f;
+  const double g = a.g, e_star = a.e_star;
   const std::size_t nx = std::size_t(grid.nodes[0]), ny = std::size_t(grid.nodes[1]);
   const std::size_t k = std::size_t(std::lround((kFloorTop - grid.origin[2]) / grid.spacing[2]));
   HertzRun3D r;
@@ -227,10 +245,8 @@ HertzRun3D run_hertz_3d(double h, double end_time) {
       second += c * (x * x + y * y);
     }
   r.radius = std::sqrt(2.5 * (second / r.plane_force - h * h / 3.0));
-  const Energies e = sim->energies();
-  r.unresolved = e.kinetic_unresolved / e.strain;
-  for (const Reaction& q : sim->reactions())
-    if (q.name == "rigid:floor") r.floor_reaction = q.force[2];
+  r.unresolved = a.unresolved;
+  r.floor_reaction = a.floor_reaction;
   std::printf(
       "[ hertz 3D ] h %.4g: quarter weight %.4f N, floor plane %.4f, floor reaction %.4f, "
       "a %.4f (Hertz %.4f, ratio %.4f), unresolved KE / U %.2e\n",
