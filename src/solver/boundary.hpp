@@ -21,6 +21,15 @@ struct BoundaryNodes {
   bool moving = false;
 };
 
+// The axis of a support on a grid plane that fixes the plane's normal
+// component (a symmetry plane: a mirror, and where domain gradients lose
+// their component across it); -1 for a box of nodes or a plane that leaves
+// its normal free.
+inline int symmetry_axis(const BoundaryNodes& b, int dimension) {
+  const int ax = b.plane_axis;
+  return ax >= 0 && ax < dimension && b.fix[std::size_t(ax)] ? ax : -1;
+}
+
 // Throws InputError when a plane does not lie on grid nodes or a boundary holds no node.
 std::vector<BoundaryNodes> resolve_boundaries(const Scene& scene);
 

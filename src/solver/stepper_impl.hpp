@@ -57,8 +57,8 @@ Stepper<D, Shape, Real>::Stepper(const Scene& scene) : scene_(scene), plan_(plan
   // The symmetry planes' nodes, for the domain gradients there.
   if (plan_.multimaterial)
     for (const BoundaryNodes& bc : boundaries_) {
-      const int ax = bc.plane_axis;
-      if (ax < 0 || ax >= D || !bc.fix[std::size_t(ax)]) continue;
+      const int ax = symmetry_axis(bc, D);
+      if (ax < 0) continue;
       if (plane_axes_.empty()) plane_axes_.assign(G_.nodes, 0);
       for (const std::uint32_t node : bc.nodes) plane_axes_[node] |= (unsigned char)(1u << ax);
     }
@@ -949,12 +949,11 @@ template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::setup_mirrors() {
   for (std::size_t b = 0; b < boundaries_.size(); ++b) {
     const BoundaryNodes& bc = boundaries_[b];
-    const int ax = bc.plane_axis;
-    if (ax < 0 || ax >= D) continue;
     // A plane that leaves its normal free lets the body leave it: an even
     // image would hold the normal strain at 0 there instead of the normal
     // stress, so it only fixes its nodes.
-    if (!bc.fix[std::size_t(ax)]) continue;
+    const int ax = symmetry_axis(bc, D);
+    if (ax < 0) continue;
     const double h = double(G_.h[ax]);
     const long plane = bc.plane_index;
     const double a = double(G_.origin[ax]) + double(plane) * h;
