@@ -132,21 +132,25 @@ std::size_t scatter_face_tractions(const ParticleView<D, Real>& P, const GridVie
 
 // The power of the listed particles' face loads, Sum_p F_p . v(face point),
 // v interpolated from GV.vel (the caller chooses which velocity that holds):
-// the power of the nodal forces scatter_face_tractions added.
+// the power of the nodal forces scatter_face_tractions added. With `load`
+// (each particle's load index) and `factor` (per load), particle p's load
+// counts factor[load[p]] times: the load of another instant of its ramp.
 template <int D, class Shape, class Real>
 double face_traction_power(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
                            const GridVelocity<D, Real>& GV,
                            const std::array<const Real*, D>& offset, const std::uint32_t* list,
-                           std::size_t count) {
+                           std::size_t count, const std::uint8_t* load = nullptr,
+                           const double* factor = nullptr) {
   FaceStencil<D, Shape, Real> st;
   double power = 0;
   for (std::size_t k = 0; k < count; ++k) {
     const std::size_t p = list[k];
     if (!st.build(P, G, offset, p)) continue;  // the scatter has reported it
+    const double f = load ? factor[load[p]] : 1.0;
     for (int d = 0; d < D; ++d) {
       double v = 0;
       for (int i = 0; i < st.count; ++i) v += st.w[i] * double(GV.vel[d][st.base + st.node[i]]);
-      power += double(P.fext[d][p]) * v;
+      power += f * double(P.fext[d][p]) * v;
     }
   }
   return power;

@@ -219,6 +219,22 @@ TEST(Determinism, SingleMaterialLinear2DUSF) {
   check_scene(s.text(), "2D linear double", 40.0);
 }
 
+// XPIC(3) ([simulation] xpic_order): three interpolations to the
+// particles and two colored scatters more per step (kernels/xpic.hpp), on
+// one material and on two in frictionless contact (two velocity fields).
+std::string with_xpic3(std::string text) {
+  const std::string section = "[simulation]\n";
+  return text.replace(text.find(section), section.size(), section + "xpic_order = 3\n");
+}
+
+TEST(Determinism, SingleMaterialGimp2DXpic) {
+  check_scene(with_xpic3(single_material("double").text()), "2D gimp double", 40.0);
+}
+
+TEST(Determinism, FrictionContactGimp2DXpic) {
+  check_scene(with_xpic3(two_materials("double", kFrictionContact).text()), "2D gimp double", 40.0);
+}
+
 // The plane y = 4 under the body is a mirror with B-splines
 // (kernels/mirror_supports.hpp): its folds and ghost velocities are serial.
 TEST(Determinism, SingleMaterialBSpline2DMirrorSupport) {
@@ -411,23 +427,46 @@ TEST(Determinism, FrictionContactTwoBlocksApproachingUSF2D) {
 // particles (solver/geometry_normals.hpp): the block slides down the
 // incline of inputs/rotated_incline.toml the same, bit for bit, on 1 and
 // 2 threads (1000 steps: past the gravity ramp, sliding).
+// A shipped scene, as parsed, stepped `steps` times on `threads` threads.
+RunResult run_parsed(const Scene& scene, int threads, int steps) {
+  omp_set_num_threads(threads);
+  auto sim = make_simulation(scene);
+  RunResult r;
+  r.particles = sim->particle_count();
+  r.nodes = sim->node_count();
+  r.initial_position = sim->particle_field("position").values;
+  for (int k = 0; k < steps; ++k) sim->step();
+  record_end(*sim, r);
+  return r;
+}
+
 TEST(Determinism, RotatedInclineGeometryNormal2D) {
   const Scene scene =
       parse_scene_file(mmpm_test::source_dir() + "/inputs/rotated_incline.toml", {});
   const int saved = omp_get_max_threads();
-  auto run_incline = [&](int threads) {
-    omp_set_num_threads(threads);
-    auto sim = make_simulation(scene);
-    RunResult r;
-    r.particles = sim->particle_count();
-    r.initial_position = sim->particle_field("position").values;
-    for (int k = 0; k < 1000; ++k) sim->step();
-    record_end(*sim, r);
-    return r;
-  };
-  const RunResult one = run_incline(1), two = run_incline(2);
+  const RunResult one = run_parsed(scene, 1, 1000), two = run_parsed(scene, 2, 1000);
   omp_set_num_threads(saved);
   EXPECT_GT(one.counters.multimaterial_nodes, 0) << "the block must be on the floor";
+  expect_identical(one, two);
+}
+
+// The half Hertz disk on the symmetry plane x = 12 (tests/test_validation_hertz.cpp):
+// the multimaterial nodes on the plane drop their gradients' x components
+// (kernels/support_gradients.hpp, a serial pass) and the plane mirrors the
+// disk. 600 steps (0.2 ms, the disk pressing into the floor under its
+// ramping weight), bit for bit the same on 1 and 2 threads.
+TEST(Determinism, HalfHertzDiskOnASymmetryPlane2D) {
+  const std::string file = mmpm_test::source_dir() + "/inputs/hertz_disk.toml";
+  const Scene scene = parse_scene_text(
+      mmpm_test::read_text(file) + "\n[[boundary]]\nwhere = { x = 12.0 }\nfix = [\"x\"]\n", file,
+      {"body[0].min=[12.0,1.0]", "body[1].clip={min=[12.0,0.0],max=[24.0,24.0]}"});
+  const int saved = omp_get_max_threads();
+  const RunResult one = run_parsed(scene, 1, 600), two = run_parsed(scene, 2, 600);
+  omp_set_num_threads(saved);
+  EXPECT_GT(one.particles, 8192u) << "too few particles for the parallel regions to switch on";
+  EXPECT_GT(one.nodes, 8192u) << "too few nodes for the parallel regions to switch on";
+  EXPECT_GT(one.counters.multimaterial_nodes, 0) << "the disk must be on the floor";
+  EXPECT_GT(one.energies.strain, 0.0);
   expect_identical(one, two);
 }
 

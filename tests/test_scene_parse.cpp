@@ -575,6 +575,7 @@ TEST(SceneParseValid, DefaultsAreFilled) {
   EXPECT_FALSE(sim.dt.has_value());
   EXPECT_EQ(sim.scheme, Scheme::MUSL);
   EXPECT_DOUBLE_EQ(sim.flip, 1.0);
+  EXPECT_EQ(sim.xpic_order, 0);
   EXPECT_EQ(sim.precision, Precision::float64);
   EXPECT_EQ(sim.default_law, Law::stick);
   EXPECT_FALSE(sim.force);
@@ -836,6 +837,10 @@ TEST(SceneParseErrors, SimulationValues) {
   sim_key("cfl = -0.5", "simulation.cfl", {"> 0"});
   sim_key("flip = 1.5", "simulation.flip", {"expected a number in [0, 1], got 1.5"});
   sim_key("flip = -0.1", "simulation.flip", {"[0, 1]"});
+  sim_key("xpic_order = 9", "simulation.xpic_order",
+          {"expected an integer from 0 (off) to 8, got 9"});
+  sim_key("xpic_order = -1", "simulation.xpic_order", {">= 0"});
+  sim_key("xpic_order = 2.5", "simulation.xpic_order", {"integer"});
   sim_key("thickness = 0.0", "simulation.thickness", {"expected a number > 0"});
   sim_key("dt = -1e-6", "simulation.dt", {"> 0"});
   sim_key("sort_every = -1", "simulation.sort_every", {">= 0"});

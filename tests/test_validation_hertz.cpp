@@ -330,7 +330,9 @@ TEST(ValidationHertzLong, LinearShapesAtTheFinestGrid) {
 // energy must stay what the loads put in, K + U + damping = W within 5 %,
 // through 1 ms. It does not: rows of particles crossing grid lines under
 // the load start a growth at 0.55 ms (cfl 0.5), and a block at rest on a
-// support does the same at every cfl from 0.1 to 0.5.
+// support does the same at every cfl from 0.1 to 0.5. The cause, shown in 1D
+// by tools/usf_cell_crossing.py: USF reads the strain of a motion at the
+// weights of where the particle ended, across the gradient's jump at a line.
 TEST(ValidationHertz, UsfWithLinearShapesStaysStableUnderLoad) {
   MMPM_KNOWN_LIMITATION(
       "USF with linear shapes goes unstable where rows of particles cross grid lines "

@@ -267,8 +267,9 @@ std::string usf_linear_warning(const Scene& scene) {
   return scene.source_file +
          ": warning: key 'simulation.scheme': \"USF\" with shape \"linear\" goes unstable where "
          "rows of particles cross grid lines under load (a block at rest on a support under "
-         "gravity stopped by 1 ms at every cfl from 0.1 to 0.5; docs/validation.md §3.11); "
-         "scheme \"MUSL\" or shape \"gimp\" runs it";
+         "gravity stopped by 1 ms at every cfl from 0.1 to 0.5): USF reads the strain of a "
+         "motion in the cell a particle ended in, not the one it moved through "
+         "(docs/validation.md §3.11); scheme \"MUSL\" or shape \"gimp\" runs it";
 }
 
 }  // namespace

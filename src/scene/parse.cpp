@@ -698,6 +698,7 @@ class SceneReader {
             "dt",
             "scheme",
             "flip",
+            "xpic_order",
             "precision",
             "default_law",
             "force",
@@ -739,6 +740,12 @@ class SceneReader {
       sim.flip = f->number();
       if (sim.flip < 0 || sim.flip > 1)
         f->fail("expected a number in [0, 1], got " + format_number(sim.flip));
+    }
+    if (auto f = t.get("xpic_order")) {
+      sim.xpic_order = f->int_at_least(0);
+      if (sim.xpic_order > kMaxXpicOrder)
+        f->fail("expected an integer from 0 (off) to " + std::to_string(kMaxXpicOrder) + ", got " +
+                std::to_string(sim.xpic_order));
     }
     if (auto f = t.get("precision")) {
       sim.precision = f->choice(kPrecisionNames);

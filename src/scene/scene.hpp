@@ -43,6 +43,11 @@ struct Where {
   std::string key;
 };
 
+// Each XPIC term costs an interpolation to the particles and a scatter back
+// (about a P2G and a G2P); the measured runs use 2-4, and at 8 terms a
+// linear velocity field is kept within 1.8e-3 (docs/validation.md §3.12).
+inline constexpr int kMaxXpicOrder = 8;
+
 struct SimulationSpec {
   int dimension = 2;
   Plane plane = Plane::strain;
@@ -54,6 +59,9 @@ struct SimulationSpec {
   // hold a sliver of mass (cell crossing, uGIMP edges) and is unstable there.
   Scheme scheme = Scheme::MUSL;
   double flip = 1.0;
+  // XPIC(m) particle velocities (kernels/xpic.hpp): 0 = off (FLIP/PIC by
+  // `flip` alone), m >= 1 filters them before the FLIP increment (1 = PIC).
+  int xpic_order = 0;  // at most kMaxXpicOrder
   Precision precision = Precision::float64;
   Law default_law = Law::stick;
   bool force = false;  // run even when dt exceeds the stability limit

@@ -29,6 +29,7 @@
 #include "kernels/support_gradients.hpp"
 #include "kernels/supports.hpp"
 #include "kernels/team.hpp"
+#include "kernels/xpic.hpp"
 #include "model/bodies.hpp"
 #include "model/material.hpp"
 #include "scene/error.hpp"
@@ -173,6 +174,9 @@ class Stepper final : public Simulation {
   void update_active_nodes();
   void set_usl_light_thresholds(const ParticleSeeds& seeds);
   void finish_velocities(bool with_dvel);
+  // [simulation] xpic_order m >= 1: the particle velocities become S v*
+  // (kernels/xpic.hpp) after the step's first P2G.
+  void xpic_filter();
   Supports<Real> supports(bool with_dvel);
   void add_rigid_work();
   void collect_support_reactions();
@@ -228,6 +232,9 @@ class Stepper final : public Simulation {
   std::vector<std::uint8_t> separation_listed_;  // its node flags (zero between steps)
   GridVelocity<D, Real> GV_;
   std::vector<Real> scratch_;
+  // xpic_filter's grid (saved p, term, sum, scatter: 4 D arrays of nodes x
+  // fields) and particle (D arrays) scratch.
+  std::vector<Real> xpic_grid_, xpic_particles_;
   // The velocity gradient of every particle (gradient_and_stress),
   // staggered like the columns.
   std::array<StaggeredArray<Real>, D * D> L_;

@@ -365,8 +365,25 @@ template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::add_face_traction_work() {
   if (!has_traction_) return;
   const std::vector<std::uint32_t>& list = loaded_particles();
-  external_work_ +=
-      dt_ * face_traction_power<D, Shape>(P_, G_, GV_, face_offset_, list.data(), list.size());
+  if (scene_.simulation.scheme != Scheme::USF) {
+    external_work_ +=
+        dt_ * face_traction_power<D, Shape>(P_, G_, GV_, face_offset_, list.data(), list.size());
+    return;
+  }
+  // USF reads, at the start of a step, the velocities of the last step's
+  // motion, which the last step's loads drove: their work is those loads'
+  // (at the last step's mid-time) on these velocities, as MUSL pairs a
+  // step's loads with the velocities it re-extrapolates at its end.
+  std::vector<double> factor(scene_.loads.size(), 0.0);  // the listed particles have a load
+  for (std::size_t l = 0; l < scene_.loads.size(); ++l) {
+    const double ramp = scene_.loads[l].ramp;
+    const double now = ramp_fraction(time_ + 0.5 * dt_, ramp);
+    const double last = std::max(0.0, ramp_fraction(time_ - 0.5 * dt_, ramp));
+    factor[l] = now > 0 ? last / now : 0.0;
+  }
+  const std::uint8_t* load = pcols_.byte("load");
+  external_work_ += dt_ * face_traction_power<D, Shape>(P_, G_, GV_, face_offset_, list.data(),
+                                                        list.size(), load, factor.data());
 }
 
 // MUSL's last particle stages and the next step's P2G in one pass, tile by
@@ -1117,6 +1134,83 @@ void Stepper<D, Shape, Real>::finish_velocities(bool with_dvel) {
   }
 }
 
+// XPIC(m) (kernels/xpic.hpp, docs/validation.md §3.12): v* = sum of the
+// first m terms (I - A)^k v from the velocities v = p / m of this step's
+// P2G, then v_p = S v* on every deformable particle. The interpolations
+// and the scatter run on the team (the scatter colored, as every P2G: the
+// same bits on 1 and 2 threads). p is put
+// back as the P2G left it: the supports' application inside
+// finish_velocities writes it, and the grid update's support reactions read
+// the change they make.
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::xpic_filter() {
+  const std::size_t N = G_.nodes * std::size_t(G_.fields), n = P_.n;
+  xpic_grid_.resize(4 * std::size_t(D) * N);
+  xpic_particles_.resize(std::size_t(D) * n);
+  std::array<Real*, D> saved, term, sum, q, w;
+  for (int d = 0; d < D; ++d) {
+    saved[d] = xpic_grid_.data() + std::size_t(d) * N;
+    term[d] = xpic_grid_.data() + std::size_t(D + d) * N;
+    sum[d] = xpic_grid_.data() + std::size_t(2 * D + d) * N;
+    q[d] = xpic_grid_.data() + std::size_t(3 * D + d) * N;
+    w[d] = xpic_particles_.data() + std::size_t(d) * n;
+    std::copy(G_.p[d], G_.p[d] + N, saved[d]);
+  }
+  auto as_const = [](const std::array<Real*, D>& a) {
+    std::array<const Real*, D> c;
+    for (int d = 0; d < D; ++d) c[d] = a[d];
+    return c;
+  };
+  auto deformable = [&](std::size_t p) { return !P_.field || !plan_.rigid[P_.field[p]]; };
+  auto fail_if_off = [&](std::size_t bad) {
+    if (bad < n) fail_particle("xpic", bad, "its shape-function stencil left the grid");
+  };
+  // The interpolations write each particle's own entries: on the team, in
+  // the particle ranges of the uncolored loops.
+  auto interpolate = [&](const std::array<const Real*, D>& u, const std::array<Real*, D>& out,
+                         const auto& take) {
+    std::atomic<std::size_t> first_bad{SIZE_MAX};
+    team_run(n >= kParallelMin, [&] {
+      const TileSchedule::Ranges mine = my_particles();
+      std::size_t bad = SIZE_MAX;
+      for (std::size_t r = 0; r < mine.count; ++r) {
+        const auto [b, e] = mine.range[r];
+        const std::size_t off =
+            interpolate_to_particles<D, Shape, Real>(P_, G_, u, out, b, e, take);
+        if (off < e) bad = std::min(bad, off);
+      }
+      offer_min(first_bad, bad);
+    });
+    fail_if_off(first_bad.load());
+  };
+  finish_velocities(false);  // v = p / m, the supports, the mirrors' ghosts
+  for (int d = 0; d < D; ++d) {
+    std::copy(GV_.vel[d], GV_.vel[d] + N, term[d]);
+    std::copy(GV_.vel[d], GV_.vel[d] + N, sum[d]);
+  }
+  for (int k = 1; k < scene_.simulation.xpic_order; ++k) {
+    interpolate(as_const(term), w, [](std::size_t) { return true; });
+    for (int d = 0; d < D; ++d) std::fill(q[d], q[d] + N, Real(0));
+    // The scatter of m_p w_p is the P2G of momenta (colored, MUSL's second
+    // transfer's kernel) with the particles' velocities and the grid's
+    // momenta pointing at the scratch arrays; the mirrors fold the image's
+    // share in as they do the P2G's.
+    std::swap(P_.v, w);
+    std::swap(G_.p, q);
+    p2g<kMomentumOnly>("xpic");
+    if (!mirrors_.empty()) fold_mirrors(kFoldMomentum, false);
+    std::swap(P_.v, w);
+    std::swap(G_.p, q);
+    add_xpic_term<D, Real>(G_.m, as_const(q), term, sum, mass_threshold_, 0, N);
+  }
+  // v* with the supports and the mirrors' ghosts, as the velocities of momenta m v*.
+  for (int d = 0; d < D; ++d)
+    for (std::size_t i = 0; i < N; ++i) G_.p[d][i] = G_.m[i] * sum[d][i];
+  finish_velocities(false);
+  interpolate(as_const(GV_.vel), P_.v, deformable);
+  for (int d = 0; d < D; ++d) std::copy(saved[d], saved[d] + N, G_.p[d]);
+}
+
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::update_tractions() {
   // Only while a ramp runs: the force is constant afterwards.
@@ -1199,6 +1293,11 @@ void Stepper<D, Shape, Real>::step() {
     fold_mirrors(kFoldMass | kFoldMomentum | kFoldForce, true);
     toc_time(kStageGrid);
   }
+  if (scene_.simulation.xpic_order > 0) {
+    tic();
+    xpic_filter();
+    toc_time(kStageG2P);
+  }
 
   if (mm) {
     tic();
@@ -1227,6 +1326,11 @@ void Stepper<D, Shape, Real>::step() {
     tic();
     finish_velocities(false);
     toc(kStageGrid);
+    // The face loads' work at the velocities this strain reads, as MUSL's
+    // (docs/validation.md §3.13): the updated grid velocity of a light node
+    // past a loaded face, which the particles do not take, read 9-14 % of
+    // extra work in the two-layer and double-lap-shear scenes with uGIMP.
+    add_face_traction_work();
     gradient_and_stress<0>();
     tic();
     p2g<kForce>("p2g");
@@ -1257,7 +1361,7 @@ void Stepper<D, Shape, Real>::step() {
     toc(kStageGrid);
   }
 
-  if (scheme != Scheme::MUSL) add_face_traction_work();
+  if (scheme == Scheme::USL) add_face_traction_work();
   if (scheme == Scheme::USL) {
     gradient_and_stress<kUpdateMotion>();
   } else if (scheme == Scheme::USF) {
