@@ -174,9 +174,10 @@ class Stepper final : public Simulation {
   void update_active_nodes();
   void set_usl_light_thresholds(const ParticleSeeds& seeds);
   void finish_velocities(bool with_dvel);
-  // [simulation] xpic_order m >= 1: the particle velocities become S v*
-  // (kernels/xpic.hpp) after the step's first P2G.
+  // [simulation] xpic_order m >= 1 (kernels/xpic.hpp): v* after the step's
+  // first P2G, and the G2P's increment shifted by v*.
   void xpic_filter();
+  void apply_xpic_shift();
   Supports<Real> supports(bool with_dvel);
   void add_rigid_work();
   void collect_support_reactions();
@@ -232,8 +233,8 @@ class Stepper final : public Simulation {
   std::vector<std::uint8_t> separation_listed_;  // its node flags (zero between steps)
   GridVelocity<D, Real> GV_;
   std::vector<Real> scratch_;
-  // xpic_filter's grid (saved p, term, sum, scatter: 4 D arrays of nodes x
-  // fields) and particle (D arrays) scratch.
+  // xpic_filter's grid (saved p, term then v*, sum, scatter: 4 D arrays of
+  // nodes x fields) and particle (D arrays) scratch.
   std::vector<Real> xpic_grid_, xpic_particles_;
   // The velocity gradient of every particle (gradient_and_stress),
   // staggered like the columns.

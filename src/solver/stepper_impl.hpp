@@ -1136,12 +1136,13 @@ void Stepper<D, Shape, Real>::finish_velocities(bool with_dvel) {
 
 // XPIC(m) (kernels/xpic.hpp, docs/validation.md §3.12): v* = sum of the
 // first m terms (I - A)^k v from the velocities v = p / m of this step's
-// P2G, then v_p = S v* on every deformable particle. The interpolations
-// and the scatter run on the team (the scatter colored, as every P2G: the
-// same bits on 1 and 2 threads). p is put
-// back as the P2G left it: the supports' application inside
-// finish_velocities writes it, and the grid update's support reactions read
-// the change they make.
+// P2G. The particles' new velocities S v* + S (v_L - v) come out of the
+// FLIP G2P itself: apply_xpic_shift adds v* to its increment and zeroes the
+// deformable particles' velocities, which saves an interpolation. The
+// interpolations and the scatter run on the team (the scatter colored, as
+// every P2G: the same bits on 1 and 2 threads). p is put back as the P2G
+// left it: the supports' application inside finish_velocities writes it,
+// and the grid update's support reactions read the change they make.
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::xpic_filter() {
   const std::size_t N = G_.nodes * std::size_t(G_.fields), n = P_.n;
@@ -1161,14 +1162,14 @@ void Stepper<D, Shape, Real>::xpic_filter() {
     for (int d = 0; d < D; ++d) c[d] = a[d];
     return c;
   };
-  auto deformable = [&](std::size_t p) { return !P_.field || !plan_.rigid[P_.field[p]]; };
-  auto fail_if_off = [&](std::size_t bad) {
-    if (bad < n) fail_particle("xpic", bad, "its shape-function stencil left the grid");
-  };
-  // The interpolations write each particle's own entries: on the team, in
-  // the particle ranges of the uncolored loops.
-  auto interpolate = [&](const std::array<const Real*, D>& u, const std::array<Real*, D>& out,
-                         const auto& take) {
+  finish_velocities(false);  // v = p / m, the supports, the mirrors' ghosts
+  for (int d = 0; d < D; ++d) {
+    std::copy(GV_.vel[d], GV_.vel[d] + N, term[d]);
+    std::copy(GV_.vel[d], GV_.vel[d] + N, sum[d]);
+  }
+  for (int k = 1; k < scene_.simulation.xpic_order; ++k) {
+    // The interpolation writes each particle's own entries: on the team, in
+    // the particle ranges of the uncolored loops.
     std::atomic<std::size_t> first_bad{SIZE_MAX};
     team_run(n >= kParallelMin, [&] {
       const TileSchedule::Ranges mine = my_particles();
@@ -1176,20 +1177,13 @@ void Stepper<D, Shape, Real>::xpic_filter() {
       for (std::size_t r = 0; r < mine.count; ++r) {
         const auto [b, e] = mine.range[r];
         const std::size_t off =
-            interpolate_to_particles<D, Shape, Real>(P_, G_, u, out, b, e, take);
+            interpolate_to_particles<D, Shape, Real>(P_, G_, as_const(term), w, b, e);
         if (off < e) bad = std::min(bad, off);
       }
       offer_min(first_bad, bad);
     });
-    fail_if_off(first_bad.load());
-  };
-  finish_velocities(false);  // v = p / m, the supports, the mirrors' ghosts
-  for (int d = 0; d < D; ++d) {
-    std::copy(GV_.vel[d], GV_.vel[d] + N, term[d]);
-    std::copy(GV_.vel[d], GV_.vel[d] + N, sum[d]);
-  }
-  for (int k = 1; k < scene_.simulation.xpic_order; ++k) {
-    interpolate(as_const(term), w, [](std::size_t) { return true; });
+    if (const std::size_t bad = first_bad.load(); bad < n)
+      fail_particle("xpic", bad, "its shape-function stencil left the grid");
     for (int d = 0; d < D; ++d) std::fill(q[d], q[d] + N, Real(0));
     // The scatter of m_p w_p is the P2G of momenta (colored, MUSL's second
     // transfer's kernel) with the particles' velocities and the grid's
@@ -1202,13 +1196,44 @@ void Stepper<D, Shape, Real>::xpic_filter() {
     std::swap(P_.v, w);
     std::swap(G_.p, q);
     add_xpic_term<D, Real>(G_.m, as_const(q), term, sum, mass_threshold_, 0, N);
+    // The folds left the ghost layer's mass at the partners, so the new
+    // term is 0 there: give the ghosts their partners' reflected values,
+    // which the next interpolation reads (as the whole body's would).
+    if (!mirrors_.empty() && k + 1 < scene_.simulation.xpic_order) {
+      std::swap(GV_.vel, term);
+      mirror_ghost_velocities(false);
+      std::swap(GV_.vel, term);
+    }
   }
-  // v* with the supports and the mirrors' ghosts, as the velocities of momenta m v*.
+  // v* with the supports and the mirrors' ghosts, as the velocities of
+  // momenta m v*; it waits in `term` for apply_xpic_shift.
   for (int d = 0; d < D; ++d)
     for (std::size_t i = 0; i < N; ++i) G_.p[d][i] = G_.m[i] * sum[d][i];
   finish_velocities(false);
-  interpolate(as_const(GV_.vel), P_.v, deformable);
-  for (int d = 0; d < D; ++d) std::copy(saved[d], saved[d] + N, G_.p[d]);
+  for (int d = 0; d < D; ++d) {
+    std::copy(GV_.vel[d], GV_.vel[d] + N, term[d]);
+    std::copy(saved[d], saved[d] + N, G_.p[d]);
+  }
+}
+
+// Right before the step's G2P (kernels/xpic.hpp): the FLIP increment
+// v_L - v takes v* more, and the deformable particles start from 0, so the
+// G2P gives them S (v* + v_L - v) (with flip < 1, blended with PIC's
+// S v_L). Rigid particles take their prescribed motion in the G2P whatever
+// they held.
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::apply_xpic_shift() {
+  const std::size_t N = G_.nodes * std::size_t(G_.fields), n = P_.n;
+  const Real* v_star = xpic_grid_.data() + std::size_t(D) * N;
+  for (int d = 0; d < D; ++d)
+    for (std::size_t i = 0; i < N; ++i) GV_.dvel[d][i] += v_star[std::size_t(d) * N + i];
+  team_run(n >= kParallelMin, [&] {
+    const TileSchedule::Ranges mine = my_particles();
+    for (std::size_t r = 0; r < mine.count; ++r)
+      for (std::size_t p = mine.range[r].first; p < mine.range[r].second; ++p)
+        if (!P_.field || !plan_.rigid[P_.field[p]])
+          for (int d = 0; d < D; ++d) P_.v[d][p] = Real(0);
+  });
 }
 
 template <int D, class Shape, class Real>
@@ -1328,7 +1353,7 @@ void Stepper<D, Shape, Real>::step() {
     toc(kStageGrid);
     // The face loads' work at the velocities this strain reads, as MUSL's
     // (docs/validation.md §3.13): the updated grid velocity of a light node
-    // past a loaded face, which the particles do not take, read 9-14 % of
+    // past a loaded face, which the particles do not take, read 9-13 % of
     // extra work in the two-layer and double-lap-shear scenes with uGIMP.
     add_face_traction_work();
     gradient_and_stress<0>();
@@ -1362,6 +1387,11 @@ void Stepper<D, Shape, Real>::step() {
   }
 
   if (scheme == Scheme::USL) add_face_traction_work();
+  if (scene_.simulation.xpic_order > 0) {
+    tic();
+    apply_xpic_shift();
+    toc_time(kStageG2P);
+  }
   if (scheme == Scheme::USL) {
     gradient_and_stress<kUpdateMotion>();
   } else if (scheme == Scheme::USF) {
