@@ -377,6 +377,20 @@ TEST(Determinism, ImperfectInterfaceFloat2D) {
   EXPECT_GT(r.counters.multimaterial_nodes, 0);
 }
 
+// A scene, as parsed, stepped `steps` times on `threads` threads.
+RunResult run_parsed(const Scene& scene, int threads, int steps) {
+  omp_set_num_threads(threads);
+  auto sim = make_simulation(scene);
+  RunResult r;
+  r.instantiation = sim->instantiation();
+  r.particles = sim->particle_count();
+  r.nodes = sim->node_count();
+  r.initial_position = sim->particle_field("position").values;
+  for (int k = 0; k < steps; ++k) sim->step();
+  record_end(*sim, r);
+  return r;
+}
+
 // Two blocks driven into each other through Coulomb contact, under `scheme`.
 void check_friction_contact(const std::string& scheme) {
   BoxScene2D s = two_materials("double", kFrictionContact);
@@ -387,22 +401,9 @@ void check_friction_contact(const std::string& scheme) {
   s.b0_vel[0] = 30.0, s.b0_vel[1] = 10.0;
   s.b1_vel[0] = -30.0, s.b1_vel[1] = -10.0;
   // The scene's own body velocities make them approach; drift 0 keeps them.
-  const std::string text = s.text();
+  const Scene scene = parse_scene_text(s.text(), "contact.toml");
   const int saved = omp_get_max_threads();
-  auto run_contact = [&](int threads) {
-    omp_set_num_threads(threads);
-    const Scene scene = parse_scene_text(text, "contact.toml");
-    auto sim = make_simulation(scene);
-    RunResult r;
-    r.instantiation = sim->instantiation();
-    r.particles = sim->particle_count();
-    r.nodes = sim->node_count();
-    r.initial_position = sim->particle_field("position").values;
-    for (int k = 0; k < kSteps; ++k) sim->step();
-    record_end(*sim, r);
-    return r;
-  };
-  const RunResult one = run_contact(1), two = run_contact(2);
+  const RunResult one = run_parsed(scene, 1, kSteps), two = run_parsed(scene, 2, kSteps);
   omp_set_num_threads(saved);
   EXPECT_EQ(one.instantiation, "2D gimp double");
   EXPECT_GT(one.particles, 8192u);
@@ -427,19 +428,6 @@ TEST(Determinism, FrictionContactTwoBlocksApproachingUSF2D) {
 // particles (solver/geometry_normals.hpp): the block slides down the
 // incline of inputs/rotated_incline.toml the same, bit for bit, on 1 and
 // 2 threads (1000 steps: past the gravity ramp, sliding).
-// A shipped scene, as parsed, stepped `steps` times on `threads` threads.
-RunResult run_parsed(const Scene& scene, int threads, int steps) {
-  omp_set_num_threads(threads);
-  auto sim = make_simulation(scene);
-  RunResult r;
-  r.particles = sim->particle_count();
-  r.nodes = sim->node_count();
-  r.initial_position = sim->particle_field("position").values;
-  for (int k = 0; k < steps; ++k) sim->step();
-  record_end(*sim, r);
-  return r;
-}
-
 TEST(Determinism, RotatedInclineGeometryNormal2D) {
   const Scene scene =
       parse_scene_file(mmpm_test::source_dir() + "/inputs/rotated_incline.toml", {});

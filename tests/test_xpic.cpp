@@ -19,34 +19,12 @@ namespace {
 // A free block (no support, no load), 2 x 2 particles per cell, its edges
 // off the grid lines.
 std::string free_block(const std::string& shape) {
-  return R"(
-[simulation]
-dimension = 2
-end_time = 1.0
-cfl = 0.5
-
-[grid]
-origin = [0.0, 0.0]
-cell = [1.0, 1.0]
-cells = [20, 20]
-shape = ")" +
-         shape + R"("
-
-[[material]]
-name = "a"
-type = "isotropic"
-density = 1.0e-3
-E = 100.0
-nu = 0.3
-
-[[body]]
-name = "b"
-material = "a"
-shape = "box"
-min = [4.3, 3.7]
-max = [14.3, 15.7]
-particles_per_cell = 2
-)";
+  mmpm_test::BoxScene2D s;
+  s.shape = shape;
+  s.scheme = "MUSL";
+  s.cells_x = 20, s.cells_y = 20;
+  s.b0_min[0] = 4.3, s.b0_min[1] = 3.7, s.b0_max[0] = 14.3, s.b0_max[1] = 15.7;
+  return s.text();
 }
 
 // The particles' velocities after one step from v_p = a + B x_p, relative
