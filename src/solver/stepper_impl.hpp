@@ -365,7 +365,8 @@ template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::add_face_traction_work() {
   if (!has_traction_) return;
   const std::vector<std::uint32_t>& list = loaded_particles();
-  if (scene_.simulation.scheme != Scheme::USF) {
+  // Once every ramp ended a step ago, USF's last loads are these loads.
+  if (scene_.simulation.scheme != Scheme::USF || time_ - 0.5 * dt_ >= traction_ramp_end_) {
     external_work_ +=
         dt_ * face_traction_power<D, Shape>(P_, G_, GV_, face_offset_, list.data(), list.size());
     return;
