@@ -5,6 +5,7 @@
 
 #include "bench/bench_common.hpp"
 #include "kernels/constitutive.hpp"
+#include "kernels/xpic.hpp"
 
 namespace mmpm::bench {
 namespace {
@@ -165,6 +166,64 @@ void bm_g2p_fused(benchmark::State& state, int threads) {
   state.counters["threads"] = threads;
 }
 
+// XPIC's interpolation of a grid velocity field to the particles
+// (kernels/xpic.hpp), on the G2P blocks: on the windows against node by
+// node on the stencil, in the particle ranges the Stepper uses (the solver
+// takes the stencil for linear shapes, the windows for the others).
+enum class Interpolation { windowed, pointwise };
+
+template <int D, class Shape, class Real, Interpolation Kernel>
+void bm_xpic_interpolation(benchmark::State& state, int threads) {
+  use_threads(threads);
+  auto& fx = g2p_fixture<D, Shape, Real>();
+  const ParticleView<D, Real>& P = fx.S.P;
+  const GridView<D, Real>& G = fx.grid.G;
+  std::array<const Real*, D> u;
+  for (int d = 0; d < D; ++d) u[d] = fx.grid.V.vel[d];
+  std::vector<Real> out_storage(static_cast<std::size_t>(D) * P.n);
+  std::array<Real*, D> out;
+  for (int d = 0; d < D; ++d) out[d] = out_storage.data() + std::size_t(d) * P.n;
+  const std::size_t n = P.n, chunks = chunk_count(n);
+  std::vector<std::size_t> stopped(chunks);
+  for (auto _ : state) {
+    team_for(n >= kParallelMin, chunks, [&](std::size_t c) {
+      const std::size_t b = c * kReduceChunk, e = std::min(n, b + kReduceChunk);
+      if constexpr (Kernel == Interpolation::windowed)
+        stopped[c] = interpolate_to_particles_windowed<D, Shape, Real>(P, G, u, out, b, e) - e;
+      else
+        stopped[c] = interpolate_to_particles_pointwise<D, Shape, Real>(P, G, u, out, b, e) - e;
+    });
+    keep(out[0]);
+    benchmark::ClobberMemory();
+  }
+  for (std::size_t s : stopped)
+    if (s != 0) {
+      state.SkipWithError("XPIC interpolation: stencil off the grid");
+      return;
+    }
+  set_ns_per_particle(state, double(n));
+  state.counters["threads"] = threads;
+}
+
+template <int D, class Shape, class Real, Interpolation Kernel>
+void register_xpic_interpolation_kernel(const char* kernel) {
+  for (int threads : {1, 2}) {
+    const std::string name = std::string("xpic_interpolation/dim:") + std::to_string(D) +
+                             "/shape:" + Shape::name + "/real:" + real_name<Real>() +
+                             "/kernel:" + kernel + "/threads:" + std::to_string(threads);
+    auto* b = benchmark::RegisterBenchmark(name.c_str(), [threads](benchmark::State& st) {
+      bm_xpic_interpolation<D, Shape, Real, Kernel>(st, threads);
+    });
+    configure(b->UseRealTime()->Unit(benchmark::kMillisecond), 0.1);
+  }
+}
+
+template <int D, class Shape, class Real>
+void register_xpic_interpolation_case() {
+  register_xpic_interpolation_kernel<D, Shape, Real, Interpolation::windowed>("windowed");
+  register_xpic_interpolation_kernel<D, Shape, Real, Interpolation::pointwise>("pointwise");
+}
+
 template <int D, class Real>
 struct ConstitutiveFixture {
   ParticleSet<D, Real> S;
@@ -276,6 +335,13 @@ void register_dim_real() {
 }  // namespace
 
 void register_g2p() {
+  register_xpic_interpolation_case<2, LinearShape, double>();
+  register_xpic_interpolation_case<2, GimpShape, double>();
+  register_xpic_interpolation_case<2, BSpline2Shape, double>();
+  register_xpic_interpolation_case<2, LinearShape, float>();
+  register_xpic_interpolation_case<3, LinearShape, double>();
+  register_xpic_interpolation_case<2, GimpShape, float>();
+  register_xpic_interpolation_case<3, GimpShape, double>();
   register_g2p_fused_case<2, LinearShape, double>();
   register_g2p_fused_case<2, LinearShape, float>();
   register_g2p_fused_case<3, GimpShape, double>();
