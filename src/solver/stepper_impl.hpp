@@ -1167,8 +1167,10 @@ void Stepper<D, Shape, Real>::xpic_filter() {
   // update does: a node's value does not depend on who computes it. The
   // scratch arrays outside the runs keep stale (finite) values, which no
   // particle reads: its window lies in its field's runs, and a window node
-  // it does not reach has weight 0. Whole-grid serial passes were ~10 % of
-  // an XPIC(4) step on the disks at h = 1/160.
+  // it does not reach has weight 0. The serial whole-grid loops were 4.4 %
+  // of an XPIC(4) step on one thread (perf, the disks at h = 1/160, 192^2
+  // nodes), besides their copies and fills, and did not gain from a second
+  // thread.
   auto node_pass = [&](auto&& body) {
     team_run(N >= kParallelMin, [&] { for_own_nodes(own_, G_.nodes, G_.fields, body); });
   };
