@@ -22,38 +22,26 @@
 #include "kernels/shape.hpp"
 #include "kernels/window.hpp"
 #include "tests/shape_configs.hpp"
+#include "tests/window_test_grid.hpp"
 
 namespace {
 
 using namespace mmpm;
 
-using mmpm_test::Cfg;
 using mmpm_test::CfgNames;
 
 template <class C>
 class WindowBatch : public ::testing::Test {};
 
-using Configs = ::testing::Types<
-    Cfg<2, LinearShape, double>, Cfg<2, LinearShape, float>, Cfg<2, GimpShape, double>,
-    Cfg<2, GimpShape, float>, Cfg<2, BSpline2Shape, double>, Cfg<2, BSpline3Shape, float>,
-    Cfg<3, LinearShape, double>, Cfg<3, GimpShape, double>, Cfg<3, GimpShape, float>,
-    Cfg<3, BSpline2Shape, double>, Cfg<3, BSpline3Shape, double>>;
-TYPED_TEST_SUITE(WindowBatch, Configs, CfgNames);
+TYPED_TEST_SUITE(WindowBatch, mmpm_test::WindowConfigs, CfgNames);
 
 // The grid of these tests: cells, spacing and origin differ per direction.
-constexpr int cells[3] = {12, 9, 7};
-constexpr double h[3] = {0.5, 0.25, 0.75}, origin[3] = {-1.0, 2.0, 0.5};
+constexpr const int (&cells)[3] = mmpm_test::kGridCells;
+constexpr const double (&h)[3] = mmpm_test::kGridH;
+constexpr const double (&origin)[3] = mmpm_test::kGridOrigin;
 template <int D, class Real>
 GridView<D, Real> test_grid() {
-  GridView<D, Real> G;
-  G.nodes = 1;
-  for (int d = 0; d < D; ++d) {
-    G.nodes_per_dim[std::size_t(d)] = cells[d] + 1;
-    G.h[std::size_t(d)] = Real(h[d]);
-    G.origin[std::size_t(d)] = Real(origin[d]);
-    G.nodes *= std::size_t(cells[d] + 1);
-  }
-  return G;
+  return mmpm_test::skewed_grid<D, Real>();
 }
 
 TYPED_TEST(WindowBatch, SameWindowsAndVerdictsAsOneByOne) {

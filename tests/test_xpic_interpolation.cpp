@@ -21,39 +21,28 @@
 
 #include "kernels/xpic.hpp"
 #include "tests/shape_configs.hpp"
+#include "tests/window_test_grid.hpp"
 
 namespace {
 
 using namespace mmpm;
 
-using mmpm_test::Cfg;
 using mmpm_test::CfgNames;
 
 template <class C>
 class XpicInterpolation : public ::testing::Test {};
 
-using Configs = ::testing::Types<
-    Cfg<2, LinearShape, double>, Cfg<2, LinearShape, float>, Cfg<2, GimpShape, double>,
-    Cfg<2, GimpShape, float>, Cfg<2, BSpline2Shape, double>, Cfg<2, BSpline3Shape, double>,
-    Cfg<3, LinearShape, double>, Cfg<3, GimpShape, double>, Cfg<3, GimpShape, float>,
-    Cfg<3, BSpline2Shape, float>, Cfg<3, BSpline3Shape, double>>;
-TYPED_TEST_SUITE(XpicInterpolation, Configs, CfgNames);
+TYPED_TEST_SUITE(XpicInterpolation, mmpm_test::WindowConfigs, CfgNames);
 
-constexpr int kCells[3] = {11, 9, 8};
-constexpr double kH[3] = {0.5, 0.25, 0.75}, kOrigin[3] = {-1.0, 2.0, 0.5};
+using mmpm_test::kGridCells;
+using mmpm_test::kGridH;
+using mmpm_test::kGridOrigin;
 
 TYPED_TEST(XpicInterpolation, WindowedEqualsTheStencilsSum) {
   constexpr int D = TypeParam::D;
   using Shape = typename TypeParam::Shape;
   using Real = typename TypeParam::Real;
-  GridView<D, Real> G;
-  G.nodes = 1;
-  for (int d = 0; d < D; ++d) {
-    G.nodes_per_dim[std::size_t(d)] = kCells[d] + 1;
-    G.h[std::size_t(d)] = Real(kH[d]);
-    G.origin[std::size_t(d)] = Real(kOrigin[d]);
-    G.nodes *= std::size_t(kCells[d] + 1);
-  }
+  GridView<D, Real> G = mmpm_test::skewed_grid<D, Real>();
   G.fields = 2;
   ASSERT_TRUE((Window<D, Shape, Real>::fits(G)));
 
@@ -83,8 +72,8 @@ TYPED_TEST(XpicInterpolation, WindowedEqualsTheStencilsSum) {
     x[d].resize(n);
     lp[d].resize(n);
     for (std::size_t p = 0; p < n; ++p) {
-      x[d][p] = Real(kOrigin[d] + (3.0 + (kCells[d] - 6.0) * r(rng)) * kH[d]);
-      lp[d][p] = Real((0.15 + 0.1 * r(rng)) * kH[d]);
+      x[d][p] = Real(kGridOrigin[d] + (3.0 + (kGridCells[d] - 6.0) * r(rng)) * kGridH[d]);
+      lp[d][p] = Real((0.15 + 0.1 * r(rng)) * kGridH[d]);
     }
     P.x[std::size_t(d)] = x[d].data();
     if (std::is_same_v<Shape, GimpShape>) P.lp[std::size_t(d)] = lp[d].data();
@@ -105,14 +94,15 @@ TYPED_TEST(XpicInterpolation, WindowedEqualsTheStencilsSum) {
   // Round-off only. The two evaluate the weights differently (the window
   // from the distance to its base, the stencil from the node's own), so a
   // weight may differ by the rounding of the cell coordinate, up to
-  // kCells[0] = 11 (eps each), times the weight's slope per cell (1 for the
+  // kGridCells[0] = 12 (eps each), times the weight's slope per cell (1 for the
   // B-splines and linear; 1 / (2 l / h) <= 3.4 for uGIMP, l >= 0.15 h), in
-  // each of D factors; |u| < 1.4. Measured: 1-5 eps (linear, B-splines),
-  // 18-19 (2D uGIMP), 30-37 (3D uGIMP), against bounds of 34-50 and 114-171.
+  // each of D factors; |u| < 1.4. Measured: 1-6 eps (linear, B-splines),
+  // 21.5-22.5 (2D uGIMP), 35 (3D uGIMP), against bounds of 36-55 and
+  // 124-186.
   // A wrong weight or node would differ by ~0.1.
   const double eps = double(std::numeric_limits<Real>::epsilon());
   const double slope = std::is_same_v<Shape, GimpShape> ? 1 / (2 * 0.15) : 1.0;
-  const double bound = eps * (1 + kCells[0]) * slope * 1.4 * D;
+  const double bound = eps * (1 + kGridCells[0]) * slope * 1.4 * D;
   double worst = 0;
   for (std::size_t i = 0; i < win.size(); ++i) {
     ASSERT_TRUE(std::isfinite(double(win[i])));
@@ -131,7 +121,7 @@ TYPED_TEST(XpicInterpolation, WindowedEqualsTheStencilsSum) {
   EXPECT_GT(moved, 0.1);
 
   // A particle off the grid: both stop there; the ones before it are written.
-  x[0][off_grid] = Real(kOrigin[0] - 2 * kH[0]);
+  x[0][off_grid] = Real(kGridOrigin[0] - 2 * kGridH[0]);
   EXPECT_EQ(run(true, n, win), off_grid);
   EXPECT_EQ(run(false, n, ref), off_grid);
   EXPECT_NE(win[off_grid - 1], Real(-7));
