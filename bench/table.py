@@ -537,6 +537,10 @@ PAIRED_SETTINGS = [
      "A with the defaults (the transfers request the particle columns they stream a batch "
      "ahead, when those columns take 4 MiB and more) and B without the requests",
      "the requests are faster", "g2p"),
+    ("xpic_2", "XPIC(2) particle velocities, paired blocks (B: xpic_order = 2)",
+     "A with the defaults (pure FLIP) and B with one term of the XPIC series (an interpolation "
+     "to the particles and a colored scatter of momenta per step, kernels/xpic.hpp)",
+     "XPIC(2) costs more", "g2p"),
     ("same_settings", "Control: two Simulations with the same settings, paired blocks",
      "A and B both with the defaults (B made after A): what the harness itself puts between two "
      "equal runs, the scale against which the rows above are read", "A is slower", "g2p"),
