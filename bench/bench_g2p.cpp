@@ -167,9 +167,9 @@ void bm_g2p_fused(benchmark::State& state, int threads) {
 }
 
 // XPIC's interpolation of a grid velocity field to the particles
-// (kernels/xpic.hpp), on the G2P blocks: on the windows against node by
-// node on the stencil, in the particle ranges the Stepper uses (the solver
-// takes the stencil for linear shapes, the windows for the others).
+// (kernels/xpic.hpp), on the G2P blocks: on the windows (the solver's,
+// wherever the grid holds a window) against node by node on the stencil,
+// in the particle ranges the Stepper uses.
 enum class Interpolation { windowed, pointwise };
 
 template <int D, class Shape, class Real, Interpolation Kernel>
