@@ -153,6 +153,14 @@ inline void for_own_nodes(const NodeOwnership& own, std::size_t nodes, int field
   });
 }
 
+// for_own_nodes on the team: each thread its own nodes, in one parallel
+// region (one thread below kParallelMin nodes x fields).
+template <class Body>
+inline void team_own_nodes(const NodeOwnership& own, std::size_t nodes, int fields, Body&& body) {
+  team_run(nodes * std::size_t(fields) >= kParallelMin,
+           [&] { for_own_nodes(own, nodes, fields, body); });
+}
+
 // A node-range hook that does nothing (the default `after` of the node passes).
 struct NoNodeHook {
   void operator()(int, std::size_t, std::size_t) const {}
@@ -163,11 +171,9 @@ struct NoNodeHook {
 template <class Real, std::size_t N>
 void zero_owned(const NodeOwnership& own, std::size_t nodes, int fields,
                 const std::array<Real*, N>& arrays) {
-  team_run(nodes * std::size_t(fields) >= kParallelMin, [&] {
-    for_own_nodes(own, nodes, fields, [&](std::size_t b, std::size_t e) {
-      for (Real* a : arrays)
-        if (a) std::fill(a + b, a + e, Real(0));
-    });
+  team_own_nodes(own, nodes, fields, [&](std::size_t b, std::size_t e) {
+    for (Real* a : arrays)
+      if (a) std::fill(a + b, a + e, Real(0));
   });
 }
 

@@ -1171,9 +1171,7 @@ void Stepper<D, Shape, Real>::xpic_filter() {
   // of an XPIC(4) step on one thread (perf, the disks at h = 1/160, 192^2
   // nodes), besides their copies and fills, and did not gain from a second
   // thread.
-  auto node_pass = [&](auto&& body) {
-    team_run(N >= kParallelMin, [&] { for_own_nodes(own_, G_.nodes, G_.fields, body); });
-  };
+  auto node_pass = [&](auto&& body) { team_own_nodes(own_, G_.nodes, G_.fields, body); };
   node_pass([&](std::size_t b, std::size_t e) {
     for (int d = 0; d < D; ++d) std::copy(G_.p[d] + b, G_.p[d] + e, saved[d] + b);
   });
@@ -1248,11 +1246,9 @@ template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::apply_xpic_shift() {
   const std::size_t N = G_.nodes * std::size_t(G_.fields), n = P_.n;
   const Real* v_star = xpic_grid_.data() + std::size_t(D) * N;
-  team_run(N >= kParallelMin, [&] {
-    for_own_nodes(own_, G_.nodes, G_.fields, [&](std::size_t b, std::size_t e) {
-      for (int d = 0; d < D; ++d)
-        for (std::size_t i = b; i < e; ++i) GV_.dvel[d][i] += v_star[std::size_t(d) * N + i];
-    });
+  team_own_nodes(own_, G_.nodes, G_.fields, [&](std::size_t b, std::size_t e) {
+    for (int d = 0; d < D; ++d)
+      for (std::size_t i = b; i < e; ++i) GV_.dvel[d][i] += v_star[std::size_t(d) * N + i];
   });
   team_run(n >= kParallelMin, [&] {
     const TileSchedule::Ranges mine = my_particles();
