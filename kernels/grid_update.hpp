@@ -185,7 +185,7 @@ double grid_update(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
     Real gacc[D];
     for (int d = 0; d < D; ++d) gacc[d] = Real(q.body_accel[d]);
     // Damping: p.p/m per node, summed below in node order.
-    double pv[kReduceChunk];
+    double pv[kNodeReduceChunk];
     const bool damping = q.damping != 0;
     auto run = [&]<bool I, bool Dmp>() {
       if (q.velocities && q.keep_momentum)
@@ -218,13 +218,13 @@ double grid_update(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
   };
   if (q.damping == 0) {
     // No loss to sum: each thread updates exactly the nodes it owns. The
-    // fixed 4096-node chunks of the sum below would hand a thread the
-    // nodes up to its last chunk's end, which the other thread owns (and
-    // whose lines sit in the other core's cache): in the 3D block of 22 707
+    // fixed chunks of the sum below hand a thread the nodes up to its last
+    // chunk's end, which the other thread owns (and whose lines sit in the
+    // other core's cache): with 4096-node chunks, in the 3D block of 22 707
     // nodes split at 11 353, thread 0 took 12 288 and ran ~1.5x longer than
     // thread 1 (docs/performance.md "The grid stage on two threads"). A
     // node's result does not depend on the range it is in.
-    team_run(G.nodes * std::size_t(G.fields) >= kParallelMin, [&] {
+    team_run(G.nodes * std::size_t(G.fields) >= kParallelMinNodes, [&] {
       for_own_field_nodes(own, G.nodes, G.fields, [&](int f, std::size_t b, std::size_t e) {
         std::array<double, 1> none{};
         update_then_hook(f, b, e, none);
@@ -289,7 +289,7 @@ void node_velocities(const GridView<D, Real>& G, const GridVelocity<D, Real>& V,
     velocity_range<CompleteDvel>(G, V, thr, o + first, o + last);
     after(f, first, last);
   };
-  team_run(G.nodes * std::size_t(G.fields) >= kParallelMin,
+  team_run(G.nodes * std::size_t(G.fields) >= kParallelMinNodes,
            [&] { for_own_field_nodes(own, G.nodes, G.fields, ranges); });
 }
 

@@ -157,7 +157,7 @@ inline void for_own_nodes(const NodeOwnership& own, std::size_t nodes, int field
 // region (one thread below kParallelMin nodes x fields).
 template <class Body>
 inline void team_own_nodes(const NodeOwnership& own, std::size_t nodes, int fields, Body&& body) {
-  team_run(nodes * std::size_t(fields) >= kParallelMin,
+  team_run(nodes * std::size_t(fields) >= kParallelMinNodes,
            [&] { for_own_nodes(own, nodes, fields, body); });
 }
 
@@ -178,21 +178,22 @@ void zero_owned(const NodeOwnership& own, std::size_t nodes, int fields,
 }
 
 // Per field f, the sum over its nodes of body(f, first, last, acc) (K
-// values), computed in the fixed chunks of deterministic_sum and added in
-// chunk order, so the totals are bitwise those of deterministic_sum field by
-// field; each thread sums the chunks that start on its own nodes.
+// values), computed in fixed chunks of kNodeReduceChunk nodes and added in
+// chunk order, so the totals do not depend on the thread count; each thread
+// sums the chunks that start on its own nodes.
 template <int K, class Body>
 std::vector<std::array<double, K>> owned_field_sums(const NodeOwnership& own, std::size_t nodes,
                                                     int fields, Body&& body) {
-  const std::size_t chunks = chunk_count(nodes);
+  constexpr std::size_t chunk = kNodeReduceChunk;
+  const std::size_t chunks = (nodes + chunk - 1) / chunk;
   std::vector<std::array<double, K>> partial(chunks * std::size_t(fields));
-  team_run(nodes * std::size_t(fields) >= kParallelMin, [&] {
+  team_run(nodes * std::size_t(fields) >= kParallelMinNodes, [&] {
     const auto [c0, c1] =
-        own.chunks(nodes, kReduceChunk, std::size_t(team_size()), std::size_t(team_rank()));
+        own.chunks(nodes, chunk, std::size_t(team_size()), std::size_t(team_rank()));
     for (int f = 0; f < fields; ++f)
       for (std::size_t c = c0; c < c1; ++c) {
         std::array<double, K> acc{};
-        const std::size_t b = c * kReduceChunk, e = std::min(nodes, (c + 1) * kReduceChunk);
+        const std::size_t b = c * chunk, e = std::min(nodes, (c + 1) * chunk);
         // A chunk's runs in node order: the skipped nodes would have added
         // +0 (zero mass), so the chunk's sum keeps its bits.
         if (own.active)

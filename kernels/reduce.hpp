@@ -17,6 +17,17 @@ inline constexpr std::size_t kReduceChunk = 4096;
 // Loops shorter than this run on one thread: waking a team costs more than
 // the work (about a microsecond per region, kernels/team.hpp).
 inline constexpr std::size_t kParallelMin = 8192;
+// Node loops (nodes x fields) shorter than this run on one thread. Lower
+// than kParallelMin: each thread updates the nodes it owns, whose lines its
+// own scatter left in its cache, while one thread alone must fetch the
+// other core's half first (docs/performance.md "Node loops of small grids
+// on the team").
+inline constexpr std::size_t kParallelMinNodes = 4096;
+// The fixed chunks of the node sums (owned_field_sums, kernels/node_ownership.hpp):
+// smaller than kReduceChunk, so that a grid of a few thousand nodes has a
+// chunk for each thread (one chunk of 4096 put a damped small grid's whole
+// update on one thread).
+inline constexpr std::size_t kNodeReduceChunk = 1024;
 
 inline std::size_t chunk_count(std::size_t n) {
   return (n + kReduceChunk - 1) / kReduceChunk;

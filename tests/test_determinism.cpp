@@ -3,14 +3,15 @@
 // positions, displacements, velocities, stresses and volumes, every energy,
 // the multimaterial counters and the reaction forces after 30 steps.
 //
-// Tolerance: none (memcmp of the values). Resolution: every scene has more
-// than 8192 particles and more than 8192 grid nodes, so that the solver's
-// parallel regions (which switch on at kParallelMin = 8192) really run on 2
-// threads: 2D scenes 110 x 90 cells of 1 mm (10101 nodes) with 12000-19200
+// Tolerance: none (memcmp of the values). Resolution: every scene but the
+// two small ones at the end has more than 8192 particles and more than
+// 8192 grid nodes, so that every parallel region of the solver (which
+// switch on at kParallelMin = 8192 and below) really runs on 2 threads:
+// 2D scenes 110 x 90 cells of 1 mm (10101 nodes) with 12000-19200
 // particles (2 per cell and direction); the 3D scene 24 x 22 x 22 cells
 // (13225 nodes) with 13824 particles. The initial velocity field is
-// non-uniform (so stresses build up at once) and fast enough (~0.5-1 cell in
-// 30 steps) that particles change tiles and the solver re-sorts them.
+// non-uniform (so stresses build up at once) and fast enough (~0.5-1 cell
+// in 30 steps) that particles change tiles and the solver re-sorts them.
 #include <gtest/gtest.h>
 #include <omp.h>
 
@@ -500,6 +501,66 @@ ramp = 0.004
 kind = "gravity"
 acceleration = [0.0, 0.0, -10.0]
 )";
+}
+
+// Small scenes, where the thresholds of the parallel regions decide what
+// runs on the team (Stepper::particles_on_team, kParallelMinNodes,
+// kNodeReduceChunk; docs/performance.md "Node loops of small grids, and
+// particle passes by their work"): the same bitwise check, with the sizes
+// asserted to sit in the regime each scene is for.
+RunResult check_small_scene(const std::string& text, const std::string& instantiation,
+                            double drift) {
+  const int saved = omp_get_max_threads();
+  const RunResult one = run(text, 1, drift);
+  const RunResult two = run(text, 2, drift);
+  omp_set_num_threads(saved);
+  EXPECT_EQ(one.instantiation, instantiation);
+  EXPECT_EQ(one.steps, kSteps);
+  expect_identical(one, two);
+  double max_move = 0;
+  for (std::size_t i = 0; i < one.fields[0].size(); ++i)
+    max_move = std::max(max_move, std::abs(one.fields[0][i] - one.initial_position[i]));
+  EXPECT_GT(max_move, 0.3) << "particles should cross cells (and tiles) during the run";
+  EXPECT_GT(one.energies.strain, 0.0);
+  return one;
+}
+
+// 2D uGIMP, two materials joined by an imperfect interface, grid damping:
+// 6240 particles (below 8192, above uGIMP's 3641: the particle passes on
+// the team) and 61 x 41 nodes x 2 fields = 5002 (between 4096 and 8192: the
+// node loops on the team, the damped update summed in 1024-node chunks, 3
+// per field, shared by the two threads).
+TEST(Determinism, SmallDampedInterfaceGimp2D) {
+  BoxScene2D s = two_materials("double", kNumericInterface);
+  s.cells_x = 60, s.cells_y = 40;
+  s.b0_min[0] = 4, s.b0_min[1] = 4, s.b0_max[0] = 34, s.b0_max[1] = 34;
+  s.b1_min[0] = 34, s.b1_min[1] = 4, s.b1_max[0] = 56, s.b1_max[1] = 34;
+  std::string text = s.text();
+  const std::string grid_shape = "shape = \"gimp\"\n\n";
+  const std::size_t at = text.find(grid_shape);  // the [grid] table's (bodies: "box")
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, grid_shape.size(), "shape = \"gimp\"\ndamping = 25.0\n\n");
+  const RunResult r = check_small_scene(text, "2D gimp double", 40.0);
+  EXPECT_EQ(r.particles, 6240u);
+  EXPECT_EQ(r.nodes, 2501u);
+  EXPECT_GT(r.energies.damping, 0.0) << "the damped update's sum must have run";
+}
+
+// 3D uGIMP, 4096 particles (above 3D uGIMP's 1214: the particle passes on
+// the team) on 15^3 = 3375 nodes of one field (below 4096: the node loops
+// on one thread, after passes on two).
+TEST(Determinism, SmallGimp3D) {
+  std::string text = scene_3d();
+  const auto swap = [&text](const std::string& from, const std::string& to) {
+    const std::size_t at = text.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+  };
+  swap("cells = [24, 22, 22]", "cells = [14, 14, 14]");
+  swap("max = [15.0, 15.0, 15.0]", "max = [11.0, 11.0, 11.0]");
+  const RunResult r = check_small_scene(text, "3D gimp double", 40.0);
+  EXPECT_EQ(r.particles, 4096u);
+  EXPECT_EQ(r.nodes, 3375u);
 }
 
 TEST(Determinism, Gimp3DTractionGravity) {

@@ -124,6 +124,18 @@ class Stepper final : public Simulation {
   TileSchedule::Ranges my_particles() const {
     return schedule_.thread_ranges(std::size_t(team_size()), std::size_t(team_rank()));
   }
+  // Whether the particle passes run on the team. A pass's work per particle
+  // grows with the stencil (Shape::S^D nodes), so the particle count that
+  // pays for the regions falls with it: kParallelMin (8192) for 2D linear
+  // (4 nodes), 3641 for 2D uGIMP (9), 1214 for 3D uGIMP (27). With the
+  // count alone, a 3D scene of 8000 particles (sphere_in_cube.toml) ran
+  // every transfer on one thread (docs/performance.md "Particle passes on
+  // the team by their work").
+  bool particles_on_team() const {
+    std::size_t stencil = 1;
+    for (int d = 0; d < D; ++d) stencil *= std::size_t(Shape::S);
+    return P_.n * stencil >= kParallelMin * 4;
+  }
   void zero_grid(bool mm);
   template <unsigned What>
   void p2g(const char* stage_label);

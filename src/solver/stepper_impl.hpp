@@ -423,11 +423,11 @@ void Stepper<D, Shape, Real>::fused_step_tail() {
   // L of one tile per thread, columns a multiple of 64 bytes apart.
   const std::size_t l_stride = (max_tile_particles_ + 7) / 8 * 8;
   const std::size_t l_block = l_stride * std::size_t(D * D);
-  const std::size_t team = P_.n >= kParallelMin ? std::size_t(omp_get_max_threads()) : 1;
+  const std::size_t team = particles_on_team() ? std::size_t(omp_get_max_threads()) : 1;
   if (tail_L_.size() < team * l_block) tail_L_.assign(team * l_block, Real(0));
   for (std::size_t c = 0; c < schedule_.tiles.size(); ++c) {
     if (schedule_.tiles[c].empty()) continue;
-    team_run(P_.n >= kParallelMin, [&] {
+    team_run(particles_on_team(), [&] {
       std::size_t bad = SIZE_MAX, unsound = SIZE_MAX;
       double mine[3] = {0, 0, 0};
       ParticleView<D, Real> Pt = P_;
@@ -650,7 +650,7 @@ void Stepper<D, Shape, Real>::p2g(const char* label) {
   std::atomic<std::size_t> first_bad{SIZE_MAX};
   for (std::size_t c = 0; c < schedule_.tiles.size(); ++c) {
     if (schedule_.tiles[c].empty()) continue;
-    team_run(P_.n >= kParallelMin, [&] {
+    team_run(particles_on_team(), [&] {
       std::size_t bad = SIZE_MAX;
       for (auto [k, last] = color_share(c); k < last; ++k) {
         const std::uint32_t t = schedule_.tiles[c][k];
@@ -683,13 +683,13 @@ void Stepper<D, Shape, Real>::p2g_multimaterial() {
   if (!scattered) {
     const P2GOptions opt = p2g_options();
     const std::size_t bad = p2g_multimaterial_fields<D, Shape, Real>(
-        P_, G_, opt, tiles_, schedule_, reach_tiles_, domain_gradient_, P_.n >= kParallelMin);
+        P_, G_, opt, tiles_, schedule_, reach_tiles_, domain_gradient_, particles_on_team());
     if (bad != SIZE_MAX) fail_particle("p2g", bad, "its shape-function stencil left the grid");
   }
   if (moments_.enabled()) {  // separation = "extrapolated": mx from the centroids to the nodes
     const std::size_t bad = extrapolate_separation<D, Shape, Real>(
         P_, G_, moments_, schedule_, reach_tiles_, mm_.nodes(), plan_.rigid.data(),
-        mm_.mass_threshold(), separation_listed_, P_.n >= kParallelMin);
+        mm_.mass_threshold(), separation_listed_, particles_on_team());
     if (bad != SIZE_MAX) fail_particle("p2g", bad, "its shape-function stencil left the grid");
   }
 }
@@ -752,7 +752,7 @@ void Stepper<D, Shape, Real>::g2p() {
   std::vector<G2PRangeResult> res(chunks);
   // Fixed chunks (the external work sums in chunk order whatever the
   // threads), each run by the thread whose particles it begins in.
-  team_run(n >= kParallelMin, [&] {
+  team_run(particles_on_team(), [&] {
     const TileSchedule::Ranges mine = my_particles();
     for (std::size_t r = 0; r < mine.count; ++r) {
       const auto [first, last] = mine.range[r];
@@ -774,7 +774,7 @@ void Stepper<D, Shape, Real>::g2p_colored() {
   std::vector<G2PRangeResult> res(tiles_.tile_count);
   for (std::size_t c = 0; c < schedule_.tiles.size(); ++c) {
     if (schedule_.tiles[c].empty()) continue;
-    team_run(P_.n >= kParallelMin, [&] {
+    team_run(particles_on_team(), [&] {
       for (auto [k, last] = color_share(c); k < last; ++k) {
         const std::uint32_t t = schedule_.tiles[c][k];
         res[t] = g2p_range_of<What>(q, schedule_.begin[t], schedule_.begin[t + 1]);
@@ -793,12 +793,11 @@ void Stepper<D, Shape, Real>::g2p_colored() {
 // they are still in its cache.
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::constitutive() {
-  const std::size_t n = P_.n;
   std::atomic<std::size_t> first_bad{SIZE_MAX};
   // This step's dt (the last step may be shorter: step_within), set before
   // the threads read the table.
   isotropic_table_.dt = Real(dt_);
-  team_run(n >= kParallelMin, [&] {
+  team_run(particles_on_team(), [&] {
     const TileSchedule::Ranges mine = my_particles();
     std::size_t bad = SIZE_MAX;
     for (std::size_t r = 0; r < mine.count; ++r)
@@ -1034,7 +1033,7 @@ void Stepper<D, Shape, Real>::fold_mirrors(unsigned what, bool with_reaction) {
   if (reaction)
     for (MirrorPlane& mp : mirrors_)
       mp.fold_terms.resize(mp.ghost.size() * std::size_t(G_.fields * D));
-  team_run(G_.nodes * std::size_t(G_.fields) >= kParallelMin, [&] {
+  team_run(G_.nodes * std::size_t(G_.fields) >= kParallelMinNodes, [&] {
     const auto [first, last] = own_.mine(G_.nodes);
     for (std::size_t i = 0; i < mirrors_.size(); ++i) {
       if (i > 0) team_barrier();
@@ -1064,7 +1063,7 @@ void Stepper<D, Shape, Real>::fold_mirrors(unsigned what, bool with_reaction) {
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::mirror_ghost_velocities(bool with_dvel) {
   if (mirrors_.empty()) return;
-  team_run(G_.nodes * std::size_t(G_.fields) >= kParallelMin, [&] {
+  team_run(G_.nodes * std::size_t(G_.fields) >= kParallelMinNodes, [&] {
     const auto [first, last] = own_.mine(G_.nodes);
     for (std::size_t i = mirrors_.size(); i-- > 0;) {
       if (i + 1 < mirrors_.size()) team_barrier();
@@ -1187,7 +1186,7 @@ void Stepper<D, Shape, Real>::xpic_filter() {
     // The interpolation writes each particle's own entries: on the team, in
     // the particle ranges of the uncolored loops.
     std::atomic<std::size_t> first_bad{SIZE_MAX};
-    team_run(n >= kParallelMin, [&] {
+    team_run(particles_on_team(), [&] {
       const TileSchedule::Ranges mine = my_particles();
       std::size_t bad = SIZE_MAX;
       for (std::size_t r = 0; r < mine.count; ++r) {
@@ -1244,13 +1243,13 @@ void Stepper<D, Shape, Real>::xpic_filter() {
 // they held.
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::apply_xpic_shift() {
-  const std::size_t N = G_.nodes * std::size_t(G_.fields), n = P_.n;
+  const std::size_t N = G_.nodes * std::size_t(G_.fields);
   const Real* v_star = xpic_grid_.data() + std::size_t(D) * N;
   team_own_nodes(own_, G_.nodes, G_.fields, [&](std::size_t b, std::size_t e) {
     for (int d = 0; d < D; ++d)
       for (std::size_t i = b; i < e; ++i) GV_.dvel[d][i] += v_star[std::size_t(d) * N + i];
   });
-  team_run(n >= kParallelMin, [&] {
+  team_run(particles_on_team(), [&] {
     const TileSchedule::Ranges mine = my_particles();
     for (std::size_t r = 0; r < mine.count; ++r)
       for (std::size_t p = mine.range[r].first; p < mine.range[r].second; ++p)
@@ -1264,7 +1263,6 @@ void Stepper<D, Shape, Real>::update_tractions() {
   // Only while a ramp runs: the force is constant afterwards.
   if (!has_traction_) return;
   if (time_ > traction_ramp_end_ + dt_ && step_ > 1) return;
-  const std::size_t n = P_.n;
   const std::uint8_t* load = pcols_.byte("load");
   Real* base[3] = {pcols_.real("fbasex"), pcols_.real("fbasey"),
                    D == 3 ? pcols_.real("fbasez") : nullptr};
@@ -1275,7 +1273,7 @@ void Stepper<D, Shape, Real>::update_tractions() {
     const double tm = time_ + 0.5 * dt_;
     scale[l] = Real(ramp_fraction(tm, r));
   }
-  team_run(n >= kParallelMin, [&] {
+  team_run(particles_on_team(), [&] {
     const TileSchedule::Ranges mine = my_particles();
     for (std::size_t r = 0; r < mine.count; ++r)
       for (std::size_t p = mine.range[r].first; p < mine.range[r].second; ++p) {
