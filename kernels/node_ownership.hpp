@@ -154,7 +154,7 @@ inline void for_own_nodes(const NodeOwnership& own, std::size_t nodes, int field
 }
 
 // for_own_nodes on the team: each thread its own nodes, in one parallel
-// region (one thread below kParallelMin nodes x fields).
+// region (one thread below kParallelMinNodes nodes x fields).
 template <class Body>
 inline void team_own_nodes(const NodeOwnership& own, std::size_t nodes, int fields, Body&& body) {
   team_run(nodes * std::size_t(fields) >= kParallelMinNodes,

@@ -20,8 +20,8 @@ inline constexpr std::size_t kParallelMin = 8192;
 // Node loops (nodes x fields) shorter than this run on one thread. Lower
 // than kParallelMin: each thread updates the nodes it owns, whose lines its
 // own scatter left in its cache, while one thread alone must fetch the
-// other core's half first (docs/performance.md "Node loops of small grids
-// on the team").
+// other core's half first (docs/performance.md "Node loops of small grids,
+// and particle passes by their work").
 inline constexpr std::size_t kParallelMinNodes = 4096;
 // The fixed chunks of the node sums (owned_field_sums, kernels/node_ownership.hpp):
 // smaller than kReduceChunk, so that a grid of a few thousand nodes has a

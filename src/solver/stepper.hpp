@@ -129,8 +129,8 @@ class Stepper final : public Simulation {
   // pays for the regions falls with it: kParallelMin (8192) for 2D linear
   // (4 nodes), 3641 for 2D uGIMP (9), 1214 for 3D uGIMP (27). With the
   // count alone, a 3D scene of 8000 particles (sphere_in_cube.toml) ran
-  // every transfer on one thread (docs/performance.md "Particle passes on
-  // the team by their work").
+  // every transfer on one thread (docs/performance.md "Node loops of small
+  // grids, and particle passes by their work").
   bool particles_on_team() const {
     std::size_t stencil = 1;
     for (int d = 0; d < D; ++d) stencil *= std::size_t(Shape::S);
