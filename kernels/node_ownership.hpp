@@ -185,7 +185,7 @@ template <int K, class Body>
 std::vector<std::array<double, K>> owned_field_sums(const NodeOwnership& own, std::size_t nodes,
                                                     int fields, Body&& body) {
   constexpr std::size_t chunk = kNodeReduceChunk;
-  const std::size_t chunks = (nodes + chunk - 1) / chunk;
+  const std::size_t chunks = chunk_count(nodes, chunk);
   std::vector<std::array<double, K>> partial(chunks * std::size_t(fields));
   team_run(nodes * std::size_t(fields) >= kParallelMinNodes, [&] {
     const auto [c0, c1] =

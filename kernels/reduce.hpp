@@ -29,8 +29,8 @@ inline constexpr std::size_t kParallelMinNodes = 4096;
 // update on one thread).
 inline constexpr std::size_t kNodeReduceChunk = 1024;
 
-inline std::size_t chunk_count(std::size_t n) {
-  return (n + kReduceChunk - 1) / kReduceChunk;
+inline std::size_t chunk_count(std::size_t n, std::size_t chunk = kReduceChunk) {
+  return (n + chunk - 1) / chunk;
 }
 
 // body(begin, end, acc) adds K values into acc for indices [begin, end).

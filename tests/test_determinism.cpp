@@ -147,14 +147,13 @@ void expect_identical(const RunResult& a, const RunResult& b) {
 
 // Runs the scene on 1 and on 2 threads and compares; returns the 1-thread run
 // for scene-specific sanity checks (the scene really exercised something).
-RunResult check_scene(const std::string& text, const std::string& instantiation, double drift) {
+// The sizes are the caller's to check (check_scene; the small scenes below).
+RunResult check_runs(const std::string& text, const std::string& instantiation, double drift) {
   const int saved = omp_get_max_threads();
   const RunResult one = run(text, 1, drift);
   const RunResult two = run(text, 2, drift);
   omp_set_num_threads(saved);
   EXPECT_EQ(one.instantiation, instantiation);
-  EXPECT_GT(one.particles, 8192u) << "too few particles for the parallel regions to switch on";
-  EXPECT_GT(one.nodes, 8192u) << "too few nodes for the parallel regions to switch on";
   EXPECT_EQ(one.steps, kSteps);
   expect_identical(one, two);
   // Something happened: particles moved by a fair part of a cell, stresses built up.
@@ -166,6 +165,21 @@ RunResult check_scene(const std::string& text, const std::string& instantiation,
   EXPECT_GT(max_stress, 0.0);
   EXPECT_GT(one.energies.strain, 0.0);
   return one;
+}
+
+// check_runs on a scene large enough for every parallel region.
+RunResult check_scene(const std::string& text, const std::string& instantiation, double drift) {
+  const RunResult one = check_runs(text, instantiation, drift);
+  EXPECT_GT(one.particles, 8192u) << "too few particles for the parallel regions to switch on";
+  EXPECT_GT(one.nodes, 8192u) << "too few nodes for the parallel regions to switch on";
+  return one;
+}
+
+// Replaces the first `from` in text by `to` (a scene variant).
+void replace_once(std::string& text, const std::string& from, const std::string& to) {
+  const std::size_t at = text.find(from);
+  ASSERT_NE(at, std::string::npos) << from;
+  text.replace(at, from.size(), to);
 }
 
 // (a) One material, traction on the top face, gravity, a fixed plane.
@@ -318,9 +332,7 @@ TEST(Determinism, ImperfectInterfaceLargeTiles2D) {
     BoxScene2D s = two_materials("double", kNumericInterface);
     s.scheme = "MUSL";  // the fused tail
     std::string text = s.text();
-    const std::size_t grid = text.find("[grid]\n");
-    ASSERT_NE(grid, std::string::npos);
-    text.insert(grid + 7, std::string("tile = ") + edge + "\n");
+    replace_once(text, "[grid]\n", std::string("[grid]\ntile = ") + edge + "\n");
     EXPECT_EQ(make_simulation(parse_scene_text(text, "tiles.toml"))->tile_edge(), std::stoi(edge));
     const RunResult r = check_scene(text, "2D gimp double", 40.0);
     EXPECT_GT(r.counters.multimaterial_nodes, 0);
@@ -506,24 +518,8 @@ acceleration = [0.0, 0.0, -10.0]
 // Small scenes, where the thresholds of the parallel regions decide what
 // runs on the team (Stepper::particles_on_team, kParallelMinNodes,
 // kNodeReduceChunk; docs/performance.md "Node loops of small grids, and
-// particle passes by their work"): the same bitwise check, with the sizes
-// asserted to sit in the regime each scene is for.
-RunResult check_small_scene(const std::string& text, const std::string& instantiation,
-                            double drift) {
-  const int saved = omp_get_max_threads();
-  const RunResult one = run(text, 1, drift);
-  const RunResult two = run(text, 2, drift);
-  omp_set_num_threads(saved);
-  EXPECT_EQ(one.instantiation, instantiation);
-  EXPECT_EQ(one.steps, kSteps);
-  expect_identical(one, two);
-  double max_move = 0;
-  for (std::size_t i = 0; i < one.fields[0].size(); ++i)
-    max_move = std::max(max_move, std::abs(one.fields[0][i] - one.initial_position[i]));
-  EXPECT_GT(max_move, 0.3) << "particles should cross cells (and tiles) during the run";
-  EXPECT_GT(one.energies.strain, 0.0);
-  return one;
-}
+// particle passes by their work"): check_runs, with the sizes asserted to
+// sit in the regime each scene is for.
 
 // 2D uGIMP, two materials joined by an imperfect interface, grid damping:
 // 6240 particles (below 8192, above uGIMP's 3641: the particle passes on
@@ -536,11 +532,9 @@ TEST(Determinism, SmallDampedInterfaceGimp2D) {
   s.b0_min[0] = 4, s.b0_min[1] = 4, s.b0_max[0] = 34, s.b0_max[1] = 34;
   s.b1_min[0] = 34, s.b1_min[1] = 4, s.b1_max[0] = 56, s.b1_max[1] = 34;
   std::string text = s.text();
-  const std::string grid_shape = "shape = \"gimp\"\n\n";
-  const std::size_t at = text.find(grid_shape);  // the [grid] table's (bodies: "box")
-  ASSERT_NE(at, std::string::npos);
-  text.replace(at, grid_shape.size(), "shape = \"gimp\"\ndamping = 25.0\n\n");
-  const RunResult r = check_small_scene(text, "2D gimp double", 40.0);
+  // The first is the [grid] table's (the bodies' shape is "box").
+  replace_once(text, "shape = \"gimp\"\n\n", "shape = \"gimp\"\ndamping = 25.0\n\n");
+  const RunResult r = check_runs(text, "2D gimp double", 40.0);
   EXPECT_EQ(r.particles, 6240u);
   EXPECT_EQ(r.nodes, 2501u);
   EXPECT_GT(r.energies.damping, 0.0) << "the damped update's sum must have run";
@@ -551,14 +545,9 @@ TEST(Determinism, SmallDampedInterfaceGimp2D) {
 // on one thread, after passes on two).
 TEST(Determinism, SmallGimp3D) {
   std::string text = scene_3d();
-  const auto swap = [&text](const std::string& from, const std::string& to) {
-    const std::size_t at = text.find(from);
-    ASSERT_NE(at, std::string::npos) << from;
-    text.replace(at, from.size(), to);
-  };
-  swap("cells = [24, 22, 22]", "cells = [14, 14, 14]");
-  swap("max = [15.0, 15.0, 15.0]", "max = [11.0, 11.0, 11.0]");
-  const RunResult r = check_small_scene(text, "3D gimp double", 40.0);
+  replace_once(text, "cells = [24, 22, 22]", "cells = [14, 14, 14]");
+  replace_once(text, "max = [15.0, 15.0, 15.0]", "max = [11.0, 11.0, 11.0]");
+  const RunResult r = check_runs(text, "3D gimp double", 40.0);
   EXPECT_EQ(r.particles, 4096u);
   EXPECT_EQ(r.nodes, 3375u);
 }
