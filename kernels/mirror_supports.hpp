@@ -94,6 +94,53 @@ void fold_mirror(const GridView<D, Real>& G, const MirrorView<Real>& M, int f, u
   }
 }
 
+// The image of a multimaterial field's separation, volume and domain
+// gradient (ALGORITHM §1: mx, Omega, g; docs/contact_validation.md §22).
+// The mass fold gives a partner node the image's mass; the interface and
+// contact laws read mx / m (the field's displacement or position there),
+// Omega (the contact area) and g (the normals) beside it, so those get the
+// image too, or a partner's displacement reads the body's sum over the
+// body's and the image's mass. The image's separation coordinate is the
+// body's reflected: along an odd axis, s_odd - u with s_odd = 2 x the
+// plane's displacement (or position); along the others, u. Its gradient is
+// the body's with the plane-normal component negated (normal_axis).
+//
+// On the plane's own nodes the image doubles every sum (as the mass, which
+// the fold leaves single: a ratio is all the laws read) and makes the odd
+// components of mx those of the plane itself: m s / 2 per field. Only the
+// entries whose partner is read (is_read nonzero: a multimaterial node, or a
+// ghost of another mirror folded into one) and lies in [first, last):
+// elsewhere the ghost's fields need not have been scattered this step
+// (Stepper::p2g_multimaterial scatters the tiles reaching the multimaterial
+// nodes and those ghosts).
+template <int D, class Real>
+void fold_mirror_multimaterial(const GridView<D, Real>& G, const MirrorView<Real>& M, int f,
+                               const bool (&odd)[3], const Real (&s_odd)[3], int normal_axis,
+                               const unsigned char* is_read, std::size_t first, std::size_t last) {
+  const std::size_t o = std::size_t(f) * G.nodes;
+  for (std::size_t k = 0; k < M.count; ++k) {
+    const std::uint32_t partner = M.partner[k];
+    if (partner < first || partner >= last || !is_read[partner]) continue;
+    const std::size_t g = o + M.ghost[k], q = o + partner, c = o + M.plane[k];
+    const Real m_g = M.ghost_mass[std::size_t(f) * M.count + k];
+    if (G.vol) {
+      G.vol[q] += G.vol[g];
+      G.vol[g] = Real(0);
+    }
+    for (int d = 0; d < D; ++d) {
+      if (G.mx[d]) {
+        G.mx[d][q] += odd[d] ? m_g * s_odd[d] - G.mx[d][g] : G.mx[d][g];
+        G.mx[d][g] = Real(0);
+        if (odd[d]) G.mx[d][c] = Real(0.5) * G.m[c] * s_odd[d];
+      }
+      if (G.g[d]) {
+        G.g[d][q] += d == normal_axis ? -G.g[d][g] : G.g[d][g];
+        G.g[d][g] = Real(0);
+      }
+    }
+  }
+}
+
 // Adds to reaction (D entries) the force the image exerted on the body in
 // fold_mirror's force fold, from its terms (count x D), in entry order: the
 // bits of the serial loop that accumulated them as it folded.

@@ -258,6 +258,20 @@ TEST(Determinism, SingleMaterialBSpline2DMirrorSupport) {
   check_scene(s.text(), "2D bspline2 double", 40.0);
 }
 
+// An interface crossing a mirror (the plane y = 4 under both bodies) with
+// B-splines: the image's mx, Omega and g fold into the partners on the team
+// (Stepper::fold_mirrors_multimaterial), the ghosts' tiles join
+// p2g_multimaterial's reach, and the mvg normals read the mirror's side
+// rule at the plane (docs/contact_validation.md §22).
+TEST(Determinism, ImperfectInterfaceAcrossAMirrorBSpline2D) {
+  BoxScene2D s =
+      two_materials("double", "law = \"interface\"\nDn = 200.0\nDt = 5.0\nnormal = \"mvg\"\n");
+  s.shape = "bspline2";
+  s.extra += "[[boundary]]\nwhere = { y = 4.0 }\nfix = [\"y\"]\n";
+  const RunResult r = check_scene(s.text(), "2D bspline2 double", 40.0);
+  EXPECT_GT(r.energies.interface, 0.0);
+}
+
 TEST(Determinism, ImperfectInterfacePerfectNormal2D) {
   // Bodies 80 cells tall: the interface's ~160 multimaterial nodes reach
   // kParallelNodes, so the multimaterial passes run on the team (60 cells

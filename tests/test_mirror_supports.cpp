@@ -90,32 +90,10 @@ TEST(MirrorSupports, HalfBarStepsLikeTheWholeBar) {
     auto whole = make_from_text(bar(c.shape, c.dim, false, 0.3, c.end), keys);
     run_until(*half, c.end);
     run_until(*whole, c.end);
-    const auto hx = field(*half, "position"), hu = field(*half, "displacement"),
-               hs = field(*half, "stress"), hv = field(*half, "velocity");
-    const auto wx = field(*whole, "position"), wu = field(*whole, "displacement"),
-               ws = field(*whole, "stress"), wv = field(*whole, "velocity");
-    std::map<std::pair<long, long>, std::size_t> by_seed;  // (x0, y0 + 16 z0) in 1/16 mm
-    auto key = [&](const auto& x, const auto& u, std::size_t p) {
-      const long z = c.dim == 3 ? std::lround(16 * (x.at(p, 2) - u.at(p, 2))) : 0;
-      return std::make_pair(std::lround(16 * (x.at(p, 0) - u.at(p, 0))),
-                            std::lround(16 * (x.at(p, 1) - u.at(p, 1))) + 1000 * z);
-    };
-    for (std::size_t p = 0; p < whole->particle_count(); ++p) by_seed[key(wx, wu, p)] = p;
     ASSERT_EQ(whole->particle_count(), 2 * half->particle_count());
-    double s_max = 0, v_max = 0, s_diff = 0, v_diff = 0;
-    for (std::size_t p = 0; p < half->particle_count(); ++p) {
-      const auto it = by_seed.find(key(hx, hu, p));
-      ASSERT_NE(it, by_seed.end());
-      const std::size_t q = it->second;
-      for (int k = 0; k < hs.components; ++k) {
-        s_max = std::max(s_max, std::abs(ws.at(q, k)));
-        s_diff = std::max(s_diff, std::abs(hs.at(p, k) - ws.at(q, k)));
-      }
-      for (int d = 0; d < c.dim; ++d) {
-        v_max = std::max(v_max, std::abs(wv.at(q, d)));
-        v_diff = std::max(v_diff, std::abs(hv.at(p, d) - wv.at(q, d)));
-      }
-    }
+    const testing::HalfWholeDifference r = testing::half_against_whole(*half, *whole, c.dim);
+    ASSERT_EQ(r.twins, half->particle_count());
+    const double s_max = r.s_max, s_diff = r.s_diff, v_max = r.v_max, v_diff = r.v_diff;
     const std::string label = std::string(c.shape) + " " + std::to_string(c.dim) + "D " + c.scheme +
                               " xpic " + std::to_string(c.xpic);
     EXPECT_GT(s_max, 1e-3) << label;  // loaded by then

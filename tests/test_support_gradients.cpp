@@ -1,7 +1,8 @@
 // drop_gradients_across_planes (kernels/support_gradients.hpp): at the
 // multimaterial nodes of a symmetry plane each field's domain gradient loses
 // the plane's normal component, unless the gradient lies mostly across the
-// plane or the node lies on planes along every axis.
+// plane or the node lies on planes along every axis; on a mirror, wherever
+// it points out through the plane.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -57,6 +58,36 @@ TEST(SupportGradients, TheGradientAcrossAPlaneIsDroppedWhereItLeansAcrossIt) {
   EXPECT_EQ(G.get(1, 1), (std::array<double, 2>{0.0, 1.0}));
   EXPECT_EQ(G.get(0, 2), (std::array<double, 2>{1.0, 1.0}));
   EXPECT_EQ(G.get(0, 3), (std::array<double, 2>{1.0, 1.0}));
+}
+
+// On a mirror (body on the +x side) a field's component across the plane
+// goes whenever it points out through it (-x: the body's cut, which the
+// image cancels), however large; one pointing into the body's side (a
+// material past the plane with a face on it) stays. A corner of two mirrors
+// loses both components that point out.
+TEST(SupportGradients, OnAMirrorTheCutsGradientGoesWhateverItsSize) {
+  Grid2 G;
+  G.set(0, 0, -2.0, 0.4);  // mostly across, out through the plane: dropped
+  G.set(1, 0, 2.0, 0.4);   // mostly across, into the body's side: kept
+  G.set(0, 1, -1.0, 1.0);
+  G.set(0, 2, -1.0, -1.0);  // corner of mirrors x (body +x) and y (body +y)
+  G.set(1, 2, -1.0, 1.0);
+  const std::vector<unsigned char> axes = {kX, kX, kX | kY, kX};
+  // bit 2d: body on +d; bit 2d + 1: on -d.
+  const std::vector<unsigned char> side = {1, 1, 1 | 4, 1};
+  const std::vector<std::uint32_t> nodes = {0, 1, 2};
+  drop_gradients_across_planes(G.view, nodes.data(), nodes.size(), axes.data(), side.data());
+  EXPECT_EQ(G.get(0, 0), (std::array<double, 2>{0.0, 0.4}));
+  EXPECT_EQ(G.get(1, 0), (std::array<double, 2>{2.0, 0.4}));
+  EXPECT_EQ(G.get(0, 1), (std::array<double, 2>{0.0, 1.0}));
+  EXPECT_EQ(G.get(0, 2), (std::array<double, 2>{0.0, 0.0}));
+  EXPECT_EQ(G.get(1, 2), (std::array<double, 2>{0.0, 1.0}));
+  // The body on the -x side: the cut's gradient points along +x.
+  Grid2 H;
+  H.set(0, 0, 2.0, 0.4);
+  const std::vector<unsigned char> below = {2, 0, 0, 0};
+  drop_gradients_across_planes(H.view, nodes.data(), 1, axes.data(), below.data());
+  EXPECT_EQ(H.get(0, 0), (std::array<double, 2>{0.0, 0.4}));
 }
 
 TEST(SupportGradients, ANodeOffThePlanesAndAGridWithoutGradientsAreLeftAlone) {

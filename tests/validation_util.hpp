@@ -4,12 +4,15 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "scene/parse.hpp"
@@ -50,6 +53,47 @@ struct Column {
 inline Column field(const Simulation& sim, const std::string& name) {
   auto f = sim.particle_field(name);
   return {std::move(f.values), f.components};
+}
+
+// A model on mirror planes against the whole body it mirrors: the largest
+// stress and velocity of the whole body's particles with a twin in the half
+// model (the same seed position, x - u), and the largest differences
+// between twins. `twins`: how many of the half model's particles found one.
+struct HalfWholeDifference {
+  double s_max = 0, s_diff = 0, v_max = 0, v_diff = 0;
+  std::size_t twins = 0;
+};
+
+inline HalfWholeDifference half_against_whole(const Simulation& half, const Simulation& whole,
+                                              int dim) {
+  const Column hx = field(half, "position"), hu = field(half, "displacement"),
+               hs = field(half, "stress"), hv = field(half, "velocity");
+  const Column wx = field(whole, "position"), wu = field(whole, "displacement"),
+               ws = field(whole, "stress"), wv = field(whole, "velocity");
+  // Seeds in 1/16 mm: (x0, y0 + 1000 z0).
+  auto key = [&](const Column& x, const Column& u, std::size_t p) {
+    const long z = dim == 3 ? std::lround(16 * (x.at(p, 2) - u.at(p, 2))) : 0;
+    return std::make_pair(std::lround(16 * (x.at(p, 0) - u.at(p, 0))),
+                          std::lround(16 * (x.at(p, 1) - u.at(p, 1))) + 1000 * z);
+  };
+  std::map<std::pair<long, long>, std::size_t> by_seed;
+  for (std::size_t p = 0; p < whole.particle_count(); ++p) by_seed[key(wx, wu, p)] = p;
+  HalfWholeDifference r;
+  for (std::size_t p = 0; p < half.particle_count(); ++p) {
+    const auto it = by_seed.find(key(hx, hu, p));
+    if (it == by_seed.end()) continue;
+    ++r.twins;
+    const std::size_t q = it->second;
+    for (int k = 0; k < hs.components; ++k) {
+      r.s_max = std::max(r.s_max, std::abs(ws.at(q, k)));
+      r.s_diff = std::max(r.s_diff, std::abs(hs.at(p, k) - ws.at(q, k)));
+    }
+    for (int d = 0; d < dim; ++d) {
+      r.v_max = std::max(r.v_max, std::abs(wv.at(q, d)));
+      r.v_diff = std::max(r.v_diff, std::abs(hv.at(p, d) - wv.at(q, d)));
+    }
+  }
+  return r;
 }
 
 }  // namespace mmpm::testing

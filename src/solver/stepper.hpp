@@ -198,6 +198,8 @@ class Stepper final : public Simulation {
   void setup_mirrors();
   MirrorView<Real> mirror_view(MirrorPlane& mp) const;
   void fold_mirrors(unsigned what, bool with_reaction);
+  void fold_mirrors_multimaterial();
+  const std::vector<std::uint32_t>& mm_nodes_with_ghosts();
   void mirror_ghost_velocities(bool with_dvel);
   void update_tractions();
   const std::vector<std::uint32_t>& loaded_particles() const;
@@ -309,16 +311,27 @@ class Stepper final : public Simulation {
   // empty without such planes or multimaterial nodes
   // (kernels/support_gradients.hpp).
   std::vector<unsigned char> plane_axes_;
+  // Per node, where it lies on a mirror normal to axis d: bit 2d with the
+  // body on the +d side, bit 2d + 1 on the -d side (empty without mirrors
+  // or multimaterial nodes).
+  std::vector<unsigned char> mirror_side_;
   // Supports on planes that act as mirrors, in boundary order: the ghost
   // layer past the plane and its partners on the body's side.
   struct MirrorPlane {
     std::size_t boundary = 0;
+    int axis = 0;           // the plane's normal
+    double coordinate = 0;  // where it lies on that axis at rest
     std::vector<std::uint32_t> ghost, partner;
     std::vector<Real> ghost_mass;             // fields x ghosts (MirrorView::ghost_mass)
     std::array<double, 3> reaction{0, 0, 0};  // this step's folds (fold_mirror)
     std::vector<double> fold_terms;           // fields x ghosts x D (fold_mirror's terms)
   };
   std::vector<MirrorPlane> mirrors_;
+  // The multimaterial nodes and the mirror ghosts of those among them that
+  // are mirror partners (p2g_multimaterial's reach), a per-node flag of the
+  // multimaterial nodes, and the nodes the separation is extrapolated at.
+  std::vector<std::uint32_t> mm_and_ghosts_, extrapolated_nodes_;
+  std::vector<unsigned char> mm_flag_;
 
   double external_work_ = 0, damping_loss_ = 0;
   std::array<double, kStageCount> stage_s_{};

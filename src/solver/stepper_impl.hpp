@@ -675,8 +675,8 @@ void Stepper<D, Shape, Real>::p2g(const char* label) {
 // many small inclusions) the next step scatters them with the first P2G.
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::p2g_multimaterial() {
-  const std::size_t reaching =
-      find_reach_tiles<D, Shape, Real>(G_, tiles_, schedule_, mm_.nodes(), reach_tiles_);
+  const std::size_t reaching = find_reach_tiles<D, Shape, Real>(
+      G_, tiles_, schedule_, mirrors_.empty() ? mm_.nodes() : mm_nodes_with_ghosts(), reach_tiles_);
   const bool scattered = mm_fields_with_p2g_;
   mm_fields_scattered_with_p2g_ = scattered;
   mm_fields_with_p2g_ = double(reaching) > scene_.simulation.mm_fields_share * double(P_.n);
@@ -688,10 +688,87 @@ void Stepper<D, Shape, Real>::p2g_multimaterial() {
   }
   if (moments_.enabled()) {  // separation = "extrapolated": mx from the centroids to the nodes
     const std::size_t bad = extrapolate_separation<D, Shape, Real>(
-        P_, G_, moments_, schedule_, reach_tiles_, mm_.nodes(), plan_.rigid.data(),
+        P_, G_, moments_, schedule_, reach_tiles_,
+        mirrors_.empty() ? mm_.nodes() : extrapolated_nodes_, plan_.rigid.data(),
         mm_.mass_threshold(), separation_listed_, particles_on_team());
     if (bad != SIZE_MAX) fail_particle("p2g", bad, "its shape-function stencil left the grid");
   }
+  if (!mirrors_.empty()) fold_mirrors_multimaterial();
+}
+
+// p2g_multimaterial's node lists with mirrors (after find_nodes and the mass
+// fold): the multimaterial nodes plus the ghosts whose fields the fold adds
+// into them (fold_mirror_multimaterial), so that the tiles reaching those
+// ghosts scatter too; and the nodes the separation is extrapolated at.
+// mm_flag_: bit 0 a multimaterial node, bit 2 a ghost folded into one (where
+// two mirrors meet, the first mirror's corner ghost folds into the second's
+// ghost, which folds into a partner: so the mirrors are visited last to
+// first), bit 1 a multimaterial node that took an image's mass. Those are
+// not extrapolated: their particles' moments hold the body's side alone,
+// about a centroid the fold moved, so they keep the centroid of the body and
+// its image (the paper's estimate).
+template <int D, class Shape, class Real>
+const std::vector<std::uint32_t>& Stepper<D, Shape, Real>::mm_nodes_with_ghosts() {
+  constexpr unsigned char kMM = 1, kImaged = 2, kGhost = 4;
+  const std::vector<std::uint32_t>& nodes = mm_.nodes();
+  if (mm_flag_.size() != G_.nodes) mm_flag_.assign(G_.nodes, 0);
+  for (const std::uint32_t n : nodes) mm_flag_[n] = kMM;
+  mm_and_ghosts_ = nodes;
+  for (std::size_t i = mirrors_.size(); i-- > 0;) {
+    const MirrorPlane& mp = mirrors_[i];
+    const std::size_t count = mp.partner.size();
+    for (std::size_t k = 0; k < count; ++k) {
+      const std::uint32_t q = mp.partner[k];
+      if (!(mm_flag_[q] & (kMM | kGhost))) continue;
+      if (!(mm_flag_[mp.ghost[k]] & kGhost)) mm_and_ghosts_.push_back(mp.ghost[k]);
+      mm_flag_[mp.ghost[k]] |= kGhost;
+      if (mm_flag_[q] & kMM)
+        for (int f = 0; f < G_.fields; ++f)
+          if (mp.ghost_mass[std::size_t(f) * count + k] > Real(0)) mm_flag_[q] |= kImaged;
+    }
+  }
+  extrapolated_nodes_.clear();
+  for (const std::uint32_t n : nodes)
+    if (!(mm_flag_[n] & kImaged)) extrapolated_nodes_.push_back(n);
+  return mm_and_ghosts_;
+}
+
+// The image's mx, Omega and g at the mirror partners that are multimaterial
+// nodes or ghosts folded into one (kernels/mirror_supports.hpp), after
+// p2g_multimaterial and the separation's extrapolation, before the normals
+// and pass A read them; the mirrors in the order of the mass fold. The
+// separation coordinate is odd along the support's fixed axes about the
+// plane's displacement u_s(t) (as the momenta about its velocity); with
+// positions (separation = "position") along the plane's normal only, about
+// the plane's position: the image's reflected coordinates.
+template <int D, class Shape, class Real>
+void Stepper<D, Shape, Real>::fold_mirrors_multimaterial() {
+  team_run(G_.nodes * std::size_t(G_.fields) >= kParallelMinNodes, [&] {
+    const auto [first, last] = own_.mine(G_.nodes);
+    for (std::size_t i = 0; i < mirrors_.size(); ++i) {
+      if (i > 0) team_barrier();
+      MirrorPlane& mp = mirrors_[i];
+      const BoundaryNodes& bc = boundaries_[mp.boundary];
+      const double moved = bc.moving ? ramp_fraction(time_, bc.ramp) : 0.0;
+      bool odd[3] = {false, false, false};
+      Real s_odd[3] = {0, 0, 0};
+      for (int d = 0; d < D; ++d) {
+        const double u_s = bc.fix[d] ? bc.displacement[d] * moved : 0.0;
+        if (plan_.position_separation) {
+          odd[d] = d == mp.axis;
+          if (odd[d]) s_odd[d] = Real(2.0 * (mp.coordinate + u_s));
+        } else {
+          odd[d] = bc.fix[d];
+          s_odd[d] = Real(2.0 * u_s);
+        }
+      }
+      const MirrorView<Real> v = mirror_view(mp);
+      for (int f = 0; f < G_.fields; ++f)
+        if (!plan_.rigid[std::size_t(f)])
+          fold_mirror_multimaterial(G_, v, f, odd, s_odd, mp.axis, mm_flag_.data(), first, last);
+    }
+  });
+  for (const std::uint32_t n : mm_and_ghosts_) mm_flag_[n] = 0;
 }
 
 template <int D, class Shape, class Real>
@@ -997,6 +1074,8 @@ void Stepper<D, Shape, Real>::setup_mirrors() {
     if (ghost < 0 || ghost > last || partner < 0 || partner > last) continue;
     MirrorPlane mp;
     mp.boundary = b;
+    mp.axis = ax;
+    mp.coordinate = a;
     const std::size_t stride =
         ax == 0   ? 1
         : ax == 1 ? std::size_t(G_.nodes_per_dim[0])
@@ -1006,6 +1085,11 @@ void Stepper<D, Shape, Real>::setup_mirrors() {
       mp.partner.push_back(std::uint32_t(long(n) + side * long(stride)));
     }
     mp.ghost_mass.assign(std::size_t(G_.fields) * mp.ghost.size(), Real(0));
+    if (plan_.multimaterial) {
+      if (mirror_side_.empty()) mirror_side_.assign(G_.nodes, 0);
+      for (const std::uint32_t n : bc.nodes)
+        mirror_side_[n] |= (unsigned char)(1u << (2 * ax + (side > 0 ? 0 : 1)));
+    }
     mirrors_.push_back(std::move(mp));
   }
 }
@@ -1362,7 +1446,8 @@ void Stepper<D, Shape, Real>::step() {
       orient_gradients(G_, mm_.nodes(), geometry_fields_, geometry_pairs_, 0.5 * Shape::S * cell);
     }
     if (!plane_axes_.empty())
-      drop_gradients_across_planes(G_, mm_.nodes().data(), mm_.nodes().size(), plane_axes_.data());
+      drop_gradients_across_planes(G_, mm_.nodes().data(), mm_.nodes().size(), plane_axes_.data(),
+                                   mirror_side_.empty() ? nullptr : mirror_side_.data());
     mm_.pass_a(G_, dt_, regular_dt_, own_);  // 0: decide for dt_
     toc(kStageMultimaterial);
   }
