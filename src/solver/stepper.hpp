@@ -327,9 +327,9 @@ class Stepper final : public Simulation {
     std::vector<double> fold_terms;           // fields x ghosts x D (fold_mirror's terms)
   };
   std::vector<MirrorPlane> mirrors_;
-  // The multimaterial nodes and the mirror ghosts of those among them that
-  // are mirror partners (p2g_multimaterial's reach), a per-node flag of the
-  // multimaterial nodes, and the nodes the separation is extrapolated at.
+  // With mirrors (mm_nodes_with_ghosts): the multimaterial nodes and the
+  // ghosts folded into them (p2g_multimaterial's reach), the nodes the
+  // separation is extrapolated at, and the per-node flags (zero between steps).
   std::vector<std::uint32_t> mm_and_ghosts_, extrapolated_nodes_;
   std::vector<unsigned char> mm_flag_;
 
