@@ -199,7 +199,7 @@ class Stepper final : public Simulation {
   MirrorView<Real> mirror_view(MirrorPlane& mp) const;
   void fold_mirrors(unsigned what, bool with_reaction);
   void fold_mirrors_multimaterial();
-  const std::vector<std::uint32_t>& mm_nodes_with_ghosts();
+  void mark_mirror_nodes();
   void mirror_ghost_velocities(bool with_dvel);
   void update_tractions();
   const std::vector<std::uint32_t>& loaded_particles() const;
@@ -327,7 +327,7 @@ class Stepper final : public Simulation {
     std::vector<double> fold_terms;           // fields x ghosts x D (fold_mirror's terms)
   };
   std::vector<MirrorPlane> mirrors_;
-  // With mirrors (mm_nodes_with_ghosts): the multimaterial nodes and the
+  // With mirrors (mark_mirror_nodes): the multimaterial nodes and the
   // ghosts folded into them (p2g_multimaterial's reach), the nodes the
   // separation is extrapolated at, and the per-node flags (zero between steps).
   std::vector<std::uint32_t> mm_and_ghosts_, extrapolated_nodes_;

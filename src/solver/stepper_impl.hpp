@@ -675,8 +675,12 @@ void Stepper<D, Shape, Real>::p2g(const char* label) {
 // many small inclusions) the next step scatters them with the first P2G.
 template <int D, class Shape, class Real>
 void Stepper<D, Shape, Real>::p2g_multimaterial() {
+  // With mirrors the ghosts folded into multimaterial nodes join the reach,
+  // and mm_flag_ holds what fold_mirrors_multimaterial reads (below).
+  const bool mirrored = !mirrors_.empty();
+  if (mirrored) mark_mirror_nodes();
   const std::size_t reaching = find_reach_tiles<D, Shape, Real>(
-      G_, tiles_, schedule_, mirrors_.empty() ? mm_.nodes() : mm_nodes_with_ghosts(), reach_tiles_);
+      G_, tiles_, schedule_, mirrored ? mm_and_ghosts_ : mm_.nodes(), reach_tiles_);
   const bool scattered = mm_fields_with_p2g_;
   mm_fields_scattered_with_p2g_ = scattered;
   mm_fields_with_p2g_ = double(reaching) > scene_.simulation.mm_fields_share * double(P_.n);
@@ -688,18 +692,18 @@ void Stepper<D, Shape, Real>::p2g_multimaterial() {
   }
   if (moments_.enabled()) {  // separation = "extrapolated": mx from the centroids to the nodes
     const std::size_t bad = extrapolate_separation<D, Shape, Real>(
-        P_, G_, moments_, schedule_, reach_tiles_,
-        mirrors_.empty() ? mm_.nodes() : extrapolated_nodes_, plan_.rigid.data(),
-        mm_.mass_threshold(), separation_listed_, particles_on_team());
+        P_, G_, moments_, schedule_, reach_tiles_, mirrored ? extrapolated_nodes_ : mm_.nodes(),
+        plan_.rigid.data(), mm_.mass_threshold(), separation_listed_, particles_on_team());
     if (bad != SIZE_MAX) fail_particle("p2g", bad, "its shape-function stencil left the grid");
   }
-  if (!mirrors_.empty()) fold_mirrors_multimaterial();
+  if (mirrored) fold_mirrors_multimaterial();
 }
 
 // p2g_multimaterial's node lists with mirrors (after find_nodes and the mass
-// fold): the multimaterial nodes plus the ghosts whose fields the fold adds
-// into them (fold_mirror_multimaterial), so that the tiles reaching those
-// ghosts scatter too; and the nodes the separation is extrapolated at.
+// fold), in mm_and_ghosts_ and extrapolated_nodes_: the multimaterial nodes
+// plus the ghosts whose fields the fold adds into them
+// (fold_mirror_multimaterial), so that the tiles reaching those ghosts
+// scatter too; and the nodes the separation is extrapolated at.
 // mm_flag_: bit 0 a multimaterial node, bit 2 a ghost folded into one (where
 // two mirrors meet, the first mirror's corner ghost folds into the second's
 // ghost, which folds into a partner: so the mirrors are visited last to
@@ -708,7 +712,7 @@ void Stepper<D, Shape, Real>::p2g_multimaterial() {
 // about a centroid the fold moved, so they keep the centroid of the body and
 // its image (the paper's estimate).
 template <int D, class Shape, class Real>
-const std::vector<std::uint32_t>& Stepper<D, Shape, Real>::mm_nodes_with_ghosts() {
+void Stepper<D, Shape, Real>::mark_mirror_nodes() {
   constexpr unsigned char kMM = 1, kImaged = 2, kGhost = 4;
   const std::vector<std::uint32_t>& nodes = mm_.nodes();
   if (mm_flag_.size() != G_.nodes) mm_flag_.assign(G_.nodes, 0);
@@ -731,7 +735,6 @@ const std::vector<std::uint32_t>& Stepper<D, Shape, Real>::mm_nodes_with_ghosts(
   extrapolated_nodes_.clear();
   for (const std::uint32_t n : nodes)
     if (!(mm_flag_[n] & kImaged)) extrapolated_nodes_.push_back(n);
-  return mm_and_ghosts_;
 }
 
 // The image's mx, Omega and g of every field (rigid ones too) at the mirror
