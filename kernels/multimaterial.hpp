@@ -256,18 +256,21 @@ void find_multimaterial_nodes(const GridView<D, Real>& grid, Real mass_threshold
       });
       offset[b + 1] = out;
     }
-    team_barrier();
-    if (team_rank() == 0) {
-      for (std::size_t b = 0; b < blocks; ++b) offset[b + 1] += offset[b];
-      list.resize(offset[blocks]);
-    }
-    team_barrier();
-    for (std::size_t b = b0; b < b1; ++b) {
-      const std::uint32_t* found = slots.get() + b * kFindBlock;
-      std::copy(found, found + (offset[b + 1] - offset[b]),
-                list.begin() + std::ptrdiff_t(offset[b]));
-    }
   });
+  // Joined after the region, on one thread: the blocks' counts and the
+  // ~250 listed nodes of an interface scene take well under a microsecond,
+  // where a prefix sum between two barriers inside the region cost two
+  // round trips between the cores (0.3-2.4 us each on the VM hosts,
+  // docs/performance.md "The multimaterial search joined after its region").
+  std::size_t total = 0;
+  for (std::size_t b = 0; b < blocks; ++b) total += offset[b + 1];
+  list.resize(total);
+  std::size_t at = 0;
+  for (std::size_t b = 0; b < blocks; ++b) {
+    const std::uint32_t* found = slots.get() + b * kFindBlock;
+    std::copy(found, found + offset[b + 1], list.begin() + std::ptrdiff_t(at));
+    at += offset[b + 1];
+  }
 }
 
 namespace mm_detail {
@@ -451,7 +454,14 @@ InteractionResult<D, Real> interact_pass_a(
   }
   const Real m_red = reduced_mass(a.m, b.m, b_is_rigid);
   VecD<D, Real> df{};
-  if (use_force_difference) df = force_difference<D, Real>(a.m, a.f, b.m, b.f, b_is_rigid);
+  // The exact spring always reads Δf_i where P2G has scattered the forces
+  // (pass_needs; USF's pass A precedes them, and reads zeros): without it a
+  // static interface's force is k s C(θ), softer by C(θ) ≈ 1 − θ²/12, and
+  // the series bars at Dn = 1e4 read their interface energy 37 % high, a
+  // shortened last step then kicking them (found by an outside review,
+  // docs/interface_validation.md "Exact integration at rest").
+  if (use_force_difference || pp.integration == Integration::exact)
+    df = force_difference<D, Real>(a.m, a.f, b.m, b.f, b_is_rigid);
 
   const Real dp_n = dot<D, Real>(G.dp, G.n);
   const DirectionOutcome<Real> on =
@@ -536,7 +546,7 @@ struct PassNeeds {
   bool geometry = true;   // mx (pass B from saved geometry reads only m, Ω, p)
   bool gradient = false;  // some pair uses the mvg / avg / rigid normal, or the closed area
   bool position = false;  // some pair uses the radial normal
-  bool force = false;     // Δf_i (pass A with cfg.use_force_difference)
+  bool force = false;     // Δf_i (pass A with cfg.use_force_difference or an exact spring)
 };
 
 template <int D, class Real>
@@ -549,6 +559,8 @@ PassNeeds pass_needs(const MMConfig<D, Real>& cfg, bool pass_a) {
     const NormalMethod method = cfg.params[cfg.pair[k]].normal_method;
     needs.position |= method == NormalMethod::radial;
     needs.gradient |= reads_domain_gradient(cfg.params[cfg.pair[k]]);
+    needs.force |= pass_a && cfg.params[cfg.pair[k]].integration == Integration::exact &&
+                   cfg.params[cfg.pair[k]].law == Law::interface;
   }
   return needs;
 }
@@ -569,7 +581,7 @@ void gather_node(const GridView<D, Real>& grid, std::size_t node, Real mass_thre
       s.p[d] = grid.p[d][at];
       s.mx[d] = needs.geometry ? grid.mx[d][at] : Real(0);
       s.g[d] = needs.gradient ? grid.g[d][at] : Real(0);
-      s.f[d] = needs.force ? grid.f[d][at] : Real(0);
+      s.f[d] = needs.force && grid.f[d] ? grid.f[d][at] : Real(0);
     }
   }
 }

@@ -287,12 +287,23 @@ TEST(Cli, TimeStepAboveStabilityLimit) {
     EXPECT_EQ(r.exit_code, 0) << r.describe();
     EXPECT_TRUE(fs::exists(tmp / "c" / "summary.json"));
   }
-  // check warns (stderr) but succeeds.
+  // check refuses it as run does (exit 2, one line, nothing printed); with
+  // --force it prints the scene and warns on stderr.
   {
     const CmdResult r = run_mmpm({"check", scene, "--set", "simulation.cfl=1.5"});
+    EXPECT_EQ(r.exit_code, 2) << r.describe();
+    const auto lines = lines_of(r.err);
+    ASSERT_EQ(lines.size(), 1u) << r.describe();
+    EXPECT_TRUE(contains(lines[0], "simulation.cfl")) << lines[0];
+    EXPECT_TRUE(contains(lower(lines[0]), "stability")) << lines[0];
+    EXPECT_TRUE(r.out.empty()) << r.out;
+  }
+  {
+    const CmdResult r = run_mmpm({"check", scene, "--set", "simulation.cfl=1.5", "--force"});
     EXPECT_EQ(r.exit_code, 0) << r.describe();
     EXPECT_TRUE(contains(lower(r.err), "warning")) << r.describe();
     EXPECT_TRUE(contains(r.err, "simulation.cfl")) << r.describe();
+    EXPECT_TRUE(contains(r.out, "[simulation]")) << r.out;
   }
 }
 
@@ -947,6 +958,7 @@ particles_per_cell = 2
   const auto lines = lines_of(apart.err);
   ASSERT_EQ(lines.size(), 2u) << apart.describe();
   for (const std::string& line : lines) {
+    // collision.toml does not set default_law: no line to name.
     EXPECT_TRUE(contains(line, scene.string() + ": warning: key 'simulation.default_law' (stick"))
         << line;
     // The search looks one cell (0.5) around each particle: beyond that,
@@ -956,6 +968,23 @@ particles_per_cell = 2
   }
   EXPECT_NE(contains(lines[0], "'block_a'"), contains(lines[1], "'block_a'")) << apart.err;
   EXPECT_NE(contains(lines[0], "'block_b'"), contains(lines[1], "'block_b'")) << apart.err;
+  // A scene that sets default_law: the warning names its line (it named
+  // the file alone until 2026-12-07).
+  {
+    std::string with_key = text;
+    const std::size_t at = with_key.find("[simulation]\n");
+    ASSERT_NE(at, std::string::npos);
+    with_key.insert(at + 13, "default_law = \"stick\"\n");
+    const long line = 2 + long(std::count(with_key.begin(), with_key.begin() + long(at), '\n'));
+    const fs::path keyed = tmp / "keyed.toml";
+    write_text(keyed, with_key);
+    const CmdResult r = run_mmpm({"check", keyed.string(), "--set", disp, "--set", touch_ab});
+    ASSERT_EQ(r.exit_code, 0) << r.describe();
+    for (const std::string& l : lines_of(r.err))
+      EXPECT_TRUE(contains(l, keyed.string() + ":" + std::to_string(line) +
+                                  ": warning: key 'simulation.default_law' (stick"))
+          << l;
+  }
 
   const CmdResult separate = run_mmpm({"check", scene.string(), "--set", disp, "--set", touch_ab,
                                        "--set", "simulation.default_law=\"separate\""});

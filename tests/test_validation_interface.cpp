@@ -866,6 +866,85 @@ TEST(ValidationInterface, RotatedDlsWithGeometryNormalMatchesTheSpecified) {
   EXPECT_NEAR(k[1] / k[0], 1.0, 0.001) << k[0] << " " << k[1];
 }
 
+// Two bars 5 x 4 mm end to end on a grid line (x = 5), Dn = 100, Dt = 1000
+// MPa/mm, the left end on a roller plane, the right end pulled by 1 MPa
+// (linear shapes, h = 0.5, 2 x 2 ppc, ν = 0, damped to rest by 1 ms; an
+// outside review's scene). Exact: U = σ² V / (2E) = 0.02 and U_int = σ² A /
+// (2 Dn) = 0.02 mJ. At the interface's end nodes each box's normal is a
+// corner's, and the signed distance switched between the shared face and
+// the side face as the bars moved: the left bar, moving 0.0025 mm, read
+// the side face there, the corner rows carried σxx ≈ 3 and U_int read
+// 0.0110. normal = "geometry" now takes the faces that face each other
+// (take_facing_faces) and gives the specified normal's energies (measured:
+// both U 0.01998, U_int 0.02084). Tolerance: the specified run's energies
+// within 1e-6; both within 5 % of exact (the grid-line interface's
+// displacement-separation bias, docs/interface_validation.md).
+TEST(ValidationInterface, BarsEndToEndWithGeometryNormalMatchTheSpecified) {
+  const std::string scene = R"([simulation]
+dimension = 2
+end_time = 1.0
+flip = 0.95
+[grid]
+origin = [-2.0, -2.0]
+cell = [0.5, 0.5]
+cells = [28, 16]
+shape = "linear"
+damping = 20.0
+[[material]]
+name = "left"
+type = "isotropic"
+density = 1.0e-3
+E = 1000.0
+nu = 0.0
+[[material]]
+name = "right"
+type = "isotropic"
+density = 1.0e-3
+E = 1000.0
+nu = 0.0
+[[body]]
+name = "l"
+material = "left"
+shape = "box"
+min = [0.0, 0.0]
+max = [5.0, 4.0]
+[[body]]
+name = "r"
+material = "right"
+shape = "box"
+min = [5.0, 0.0]
+max = [10.0, 4.0]
+[[interaction]]
+materials = ["left", "right"]
+law = "interface"
+Dn = 100.0
+Dt = 1000.0
+normal_vector = [1.0, 0.0]
+[[boundary]]
+where = { x = 0.0 }
+fix = ["x"]
+[[load]]
+kind = "traction"
+where = { body = "r", face = "x_max" }
+traction = [1.0, 0.0]
+ramp = 0.02
+)";
+  Energies e[2];
+  const char* normals[2] = {"specified", "geometry"};
+  for (int i = 0; i < 2; ++i) {
+    auto sim = testing::make_from_text(
+        scene, {std::string("interaction[0].normal=\"") + normals[i] + "\""});
+    run_until(*sim, 1.0);
+    e[i] = sim->energies();
+    std::printf("[bars end to end] %-9s U %.5f U_int %.5f (exact 0.02, 0.02)\n", normals[i],
+                e[i].strain, e[i].interface);
+    EXPECT_NEAR(e[i].strain / 0.02, 1.0, 0.05) << normals[i];
+    EXPECT_NEAR(e[i].interface / 0.02, 1.0, 0.05) << normals[i];
+  }
+  EXPECT_NEAR(e[1].strain / e[0].strain, 1.0, 1e-6);
+  EXPECT_NEAR(e[1].interface / e[0].interface, 1.0, 1e-6);
+}
+
 // Refinement h = 0.5 -> 0.25 mm over 1/Dt = 0 (perfect), 0.01, 0.1, 1 (0.25 ms).
 // At h = 0.25 every value is within 1.5 % of the shear-lag k (the perfect end, where
 // the theory's singular end tractions and the bending it ignores matter most, within
@@ -1056,6 +1135,38 @@ TEST(ValidationInterface, ExtremesExactIntegrationStable) {
                    ep = run_extreme(1e3, true, "explicit", 0.4);
   ASSERT_FALSE(ex.threw || ep.threw);
   EXPECT_NEAR(ex.compliance / ep.compliance, 1.0, 0.005);
+}
+
+// integration = "exact" at rest: the series bars of SeriesBarsNormalCompliance
+// (h = 0.5 mm, uGIMP, MUSL, static by damping at 1 ms) at Dn = 1e3 and 1e4,
+// where θ = ωΔt at the interface nodes is 0.3 and 0.9. Without Δf_i the
+// exact spring held the bars with k s C(θ): the interface energy read +3.2 %
+// and +37 % (an outside review), and a last step shortened to 0.3 Δt, whose
+// C(θ) differs, kicked the resting bars (kinetic energy 8.5e-15 -> 2.1e-11
+// mJ). Tolerances: interface energy P²/(2 Dn A) within 0.5 % (as the
+// explicit scheme's test), and still static (K < 1e-5 (U + U_int)) after the
+// short step.
+TEST(ValidationInterface, SeriesBarsExactSpringAtRestReadsTheInterfaceEnergy) {
+  const double E = 2400, A = 2.0, h = 0.5, sigma = 0.01;
+  for (double Dn : {1e3, 1e4}) {
+    SCOPED_TRACE("Dn = " + num(Dn));
+    const int nx = int(std::lround(4.0 / h)), ny = int(std::lround(12.0 / h));
+    auto sim = make_scene("series_bars.toml",
+                          {"grid.cell=[" + num(h) + "," + num(h) + "]",
+                           "grid.cells=[" + std::to_string(nx) + "," + std::to_string(ny) + "]",
+                           "interaction[0].Dn=" + num(Dn), "interaction[0].integration=\"exact\"",
+                           "load[0].traction=[0.0," + num(sigma) + "]"});
+    run_until(*sim, 1.0);
+    const auto ex = analytic::series_bars(E, 5.0, E, 5.0, Dn, A, sigma * A);
+    const Energies rest = state_of(*sim).e;
+    sim->step_within(sim->time() + 0.3 * sim->dt());
+    const Energies after = state_of(*sim).e;
+    std::printf("[bars exact] Dn %-6g U_int/exact %.5f  K %.3g -> %.3g after a 0.3 dt step\n", Dn,
+                rest.interface / ex.U_interface, rest.kinetic, after.kinetic);
+    EXPECT_NEAR(rest.interface / ex.U_interface, 1.0, 0.005);
+    EXPECT_LT(rest.kinetic, 1e-5 * (rest.strain + rest.interface)) << "not static";
+    EXPECT_LT(after.kinetic, 1e-5 * (after.strain + after.interface)) << "kicked by the short step";
+  }
 }
 
 // ---------------------------------------------------------------------------

@@ -118,6 +118,11 @@ void write_simulation(Writer& w, const Scene& s) {
   if (sim.dt) w.num("dt", *sim.dt);
   w.word("scheme", sim.scheme);
   w.num("flip", sim.flip);
+  // Written only when on, as prefetch_grid below. It was not written at
+  // all until 2026-12-07: a restart (which reads the checkpoint's resolved
+  // scene) went on without XPIC, and the resolved scene run again gave
+  // other results (found by an outside review).
+  if (sim.xpic_order > 0) w.integer("xpic_order", sim.xpic_order);
   w.word("precision", sim.precision);
   w.word("default_law", sim.default_law);
   w.boolean("force", sim.force);

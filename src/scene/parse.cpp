@@ -751,7 +751,10 @@ class SceneReader {
       sim.precision = f->choice(kPrecisionNames);
       precision_where_ = f->where();
     }
-    if (auto f = t.get("default_law")) sim.default_law = f->choice(kDefaultLawNames);
+    if (auto f = t.get("default_law")) {
+      sim.default_law = f->choice(kDefaultLawNames);
+      sim.default_law_where = f->where();
+    }
     if (auto f = t.get("force")) sim.force = f->boolean();
     if (auto f = t.get("sort_every")) sim.sort_every = f->int_at_least(0);
     if (auto f = t.get("fuse_constitutive")) sim.fuse_constitutive = f->boolean();

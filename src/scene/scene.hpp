@@ -105,7 +105,8 @@ struct SimulationSpec {
   // at multimaterial nodes are the same either way (docs/performance.md,
   // "Multimaterial fields where they are read").
   double mm_fields_share = 0.5;
-  Where step_where;  // where the time step was set (cfl or dt), for messages
+  Where step_where;         // where the time step was set (cfl or dt), for messages
+  Where default_law_where;  // where default_law was set (line 0: not in the file)
 };
 
 struct GridSpec {

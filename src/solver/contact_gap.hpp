@@ -24,7 +24,8 @@ class Simulation;
 // particles_per_cell, the largest over directions and over the fields'
 // bodies) in the simulation's current (initial) state:
 // "FILE:LINE: warning: key 'interaction[i].separation': ..." or
-// "FILE: warning: key 'simulation.default_law' (...): ...".
+// "FILE[:LINE]: warning: key 'simulation.default_law' (...): ..." (LINE
+// when the scene sets default_law).
 std::vector<std::string> open_contact_warnings(const Scene& scene, const Simulation& sim);
 
 // The opposite misuse: an interface (law = "interface") between materials

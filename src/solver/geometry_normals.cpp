@@ -68,17 +68,33 @@ FaceNormal face_normal(const GeometryNormalField& f, const Vec3& x, double step,
   }
   const double cos30 = std::sqrt(3.0) / 2;
   out.flat = true;
-  for (int k = 0; k < tangents && out.flat; ++k)
+  out.candidates[0] = out.n;
+  out.count = 1;
+  for (int k = 0; k < tangents; ++k)
     for (const double side : {-step, step}) {
       Vec3 probe = x;
       for (int d = 0; d < 3; ++d) probe[d] += side * t[std::size_t(k)][d];
       const Vec3 m = f.surface.distance(probe, &f.motion).gradient;
-      if (m[0] * out.n[0] + m[1] * out.n[1] + m[2] * out.n[2] < cos30) {
-        out.flat = false;
-        break;
-      }
+      if (m[0] * out.n[0] + m[1] * out.n[1] + m[2] * out.n[2] < cos30) out.flat = false;
+      if (m[0] != 0 || m[1] != 0 || m[2] != 0) out.candidates[std::size_t(out.count++)] = m;
     }
   return out;
+}
+
+void take_facing_faces(FaceNormal& a, FaceNormal& b) {
+  auto dot = [](const Vec3& u, const Vec3& v) { return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]; };
+  const double cos30 = std::sqrt(3.0) / 2;
+  if (dot(a.n, b.n) <= -cos30) return;  // already facing
+  double best = -cos30;
+  int ia = -1, ib = -1;
+  for (int i = 0; i < a.count; ++i)
+    for (int j = 0; j < b.count; ++j) {
+      const double c = dot(a.candidates[std::size_t(i)], b.candidates[std::size_t(j)]);
+      if (c < best) best = c, ia = i, ib = j;
+    }
+  if (ia < 0) return;  // no pair of faces faces the other: leave both
+  a.n = a.candidates[std::size_t(ia)];
+  b.n = b.candidates[std::size_t(ib)];
 }
 
 }  // namespace mmpm

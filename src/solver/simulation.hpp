@@ -126,9 +126,10 @@ std::vector<std::string> stiff_interface_warnings(const Scene& scene, double dt)
 // `run` and `check`: an end_time / dt beyond any run (1e12 steps) is bad
 // input. (The library steps on past end_time for as long as it is asked.)
 void check_step_count(const Scene& scene, double dt);
-// How close to end_time a run counts as there (the rounding of the summed
-// steps): 1e-9 of a step, or of end_time when that is shorter. With the
-// step alone, an end_time below 1e-9 dt ended before the first step (0
+// How close to end_time a run counts as there: the rounding of the summed
+// steps (their count times end_time's epsilon) plus 1e-6 of a step, or of
+// end_time when that is shorter, at most 1 % of a step. With the step
+// alone, an end_time below the tolerance ended before the first step (0
 // steps, reported as a finished run).
 double end_time_tolerance(double end_time, double dt);
 // The steps a run to end_time takes (the last one shortened to land on it):
