@@ -459,7 +459,7 @@ InteractionResult<D, Real> interact_pass_a(
   // static interface's force is k s C(θ), softer by C(θ) ≈ 1 − θ²/12, and
   // the series bars at Dn = 1e4 read their interface energy 37 % high, a
   // shortened last step then kicking them (found by an outside review,
-  // docs/interface_validation.md "Exact integration at rest").
+  // docs/interface_validation.md, Findings 12).
   if (use_force_difference || pp.integration == Integration::exact)
     df = force_difference<D, Real>(a.m, a.f, b.m, b.f, b_is_rigid);
 
