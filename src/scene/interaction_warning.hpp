@@ -11,15 +11,21 @@
 
 namespace mmpm {
 
+// "FILE:LINE: warning: " for a key read at `where` (the scene's file when
+// it has none, no line when 0: a default the scene does not set).
+inline std::string warning_at(const Scene& scene, const Where& where) {
+  std::string out = where.file.empty() ? scene.source_file : where.file;
+  if (where.line > 0) {
+    out += ':';
+    out += std::to_string(where.line);
+  }
+  return out + ": warning: ";
+}
+
 inline std::string interaction_warning(const Scene& scene, std::size_t index,
                                        const std::string& key) {
-  const InteractionSpec& it = scene.interactions[index];
-  std::string out = it.where.file.empty() ? scene.source_file : it.where.file;
-  if (it.where.line > 0) {
-    out += ':';
-    out += std::to_string(it.where.line);
-  }
-  out += ": warning: key 'interaction[";
+  std::string out = warning_at(scene, scene.interactions[index].where);
+  out += "key 'interaction[";
   out += std::to_string(index);
   out += "].";
   out += key;

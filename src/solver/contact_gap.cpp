@@ -192,10 +192,8 @@ std::string open_contact_warning(const Scene& scene, const FieldPlan& plan, cons
       << "' and '" << it.materials[1] << "' start apart";
   } else {
     // The key's line when the scene sets it (the default law has none).
-    const Where& w = scene.simulation.default_law_where;
-    m << (w.file.empty() ? scene.source_file : w.file);
-    if (w.line > 0) m << ':' << w.line;
-    m << ": warning: key 'simulation.default_law' (" << scene_name(plan.laws[l].law)
+    m << warning_at(scene, scene.simulation.default_law_where) << "key 'simulation.default_law' ("
+      << scene_name(plan.laws[l].law)
       << ", displacement separation): " << materials_of(scene, plan, c.fields[0]) << " and "
       << materials_of(scene, plan, c.fields[1])
       << " share no [[interaction]], so the default law applies, and they start apart";

@@ -6,6 +6,15 @@
 
 namespace mmpm {
 
+namespace {
+double dot(const Vec3& u, const Vec3& v) {
+  return u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+}
+// Normals closer than 30 degrees are one face (face_normal); a pair farther
+// than 150 degrees apart faces each other (take_facing_faces).
+const double kCos30 = std::sqrt(3.0) / 2;
+}  // namespace
+
 std::vector<GeometryNormalField> geometry_normal_fields(const Scene& scene, const FieldPlan& plan) {
   std::vector<GeometryNormalField> out;
   const auto F = std::size_t(plan.fields);
@@ -66,7 +75,6 @@ FaceNormal face_normal(const GeometryNormalField& f, const Vec3& x, double step,
             out.n[0] * t[0][1] - out.n[1] * t[0][0]};
     tangents = 2;
   }
-  const double cos30 = std::sqrt(3.0) / 2;
   out.flat = true;
   out.candidates[0] = out.n;
   out.count = 1;
@@ -75,17 +83,15 @@ FaceNormal face_normal(const GeometryNormalField& f, const Vec3& x, double step,
       Vec3 probe = x;
       for (int d = 0; d < 3; ++d) probe[d] += side * t[std::size_t(k)][d];
       const Vec3 m = f.surface.distance(probe, &f.motion).gradient;
-      if (m[0] * out.n[0] + m[1] * out.n[1] + m[2] * out.n[2] < cos30) out.flat = false;
+      if (dot(m, out.n) < kCos30) out.flat = false;
       if (m[0] != 0 || m[1] != 0 || m[2] != 0) out.candidates[std::size_t(out.count++)] = m;
     }
   return out;
 }
 
 void take_facing_faces(FaceNormal& a, FaceNormal& b) {
-  auto dot = [](const Vec3& u, const Vec3& v) { return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]; };
-  const double cos30 = std::sqrt(3.0) / 2;
-  if (dot(a.n, b.n) <= -cos30) return;  // already facing
-  double best = -cos30;
+  if (dot(a.n, b.n) <= -kCos30) return;  // already facing
+  double best = -kCos30;
   int ia = -1, ib = -1;
   for (int i = 0; i < a.count; ++i)
     for (int j = 0; j < b.count; ++j) {
