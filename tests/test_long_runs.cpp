@@ -101,7 +101,11 @@ TEST(LongRuns, StopCriterionEndsStaticRunEarly) {
 // steps): with flip = 1 it stops at the step flip = 0.99 stops at (6400 on
 // 2026-11-29; before, the particles' ratio rose from 1.5e-6 at 0.75 ms to
 // 2.6e-5 at 3 ms and the run went to end_time), with the same stored
-// energy within 0.1 %, while its particles still carry the unresolved part.
+// energy within 0.1 %. What the particles kept there (3.3e-11 mJ, 3e-6 of
+// the stored energy, against 9e-15 with flip = 0.99) came mostly from the
+// interface's slivers, which the pass left unbonded until 2026-12-07
+// (docs/interface_validation.md Finding 13): now 1.1e-14 mJ, 1e-9 of it.
+// Checked below 1e-7.
 TEST(LongRuns, PureFlipStaticRunStops) {
   const fs::path dir = fs::temp_directory_path() / "mmpm_stop_flip_test";
   fs::remove_all(dir);
@@ -119,9 +123,7 @@ TEST(LongRuns, PureFlipStaticRunStops) {
   EXPECT_EQ(flip.summary["stopped_by"], "kinetic_ratio");
   EXPECT_LT(flip.summary["end_time"].get<double>(), 2.0);
   EXPECT_NEAR(stored_energy(flip) / stored_energy(blend), 1.0, 1e-3);
-  // What the particles keep under pure FLIP: far above the blend's.
-  EXPECT_GT(flip.summary["energy"]["kinetic"].get<double>(),
-            1e3 * blend.summary["energy"]["kinetic"].get<double>());
+  EXPECT_LT(flip.summary["energy"]["kinetic"].get<double>(), 1e-7 * stored_energy(flip));
   fs::remove_all(dir);
 }
 

@@ -90,6 +90,8 @@ class MultimaterialStage {
     // Contact and interfaces ignore a material whose nodal mass is a sliver
     // (ALGORITHM §4.3): 1e-6 of the lightest particle, well above round-off.
     cfg_.mass_threshold = min_particle_mass * Real(kSliverMassFraction);
+    // Interfaces bond every field the grid gives a velocity (MMConfig::bond_threshold).
+    if (has_interface_) cfg_.bond_threshold = min_particle_mass * Real(kEmptyMassFraction);
     cfg_.dt = Real(dt);
     // USF: pass A's momenta are the strain's velocities (docs/contact_validation.md §13).
     usf_ = scene.simulation.scheme == Scheme::USF;
@@ -126,10 +128,10 @@ class MultimaterialStage {
   void find_nodes(const GridView<D, Real>& grid, const NodeOwnership& own,
                   const MixedTiles<D>* mixed = nullptr) {
     if (!enabled_) return;
-    find_multimaterial_nodes(grid, cfg_.mass_threshold, list_, own, mixed);
+    find_multimaterial_nodes(grid, cfg_.listed_threshold(), list_, own, mixed);
   }
   const std::vector<std::uint32_t>& nodes() const { return list_; }
-  Real mass_threshold() const { return cfg_.mass_threshold; }
+  Real listed_threshold() const { return cfg_.listed_threshold(); }
 
   // After find_nodes and the multimaterial fields' P2G.
   // limit_dt: the step the stick decisions are made for (MMConfig::limit_dt;
