@@ -18,17 +18,17 @@ namespace mmpm {
 template <int D, class Real>
 using VecD = std::array<Real, D>;
 
-// ALGORITHM §4.3: at a node, a material field of at most this fraction of the
-// lightest particle's mass is a sliver, empty to contact (MultimaterialStage;
-// an interface bonds it, MMConfig::bond_threshold) and a light node to USL
-// (Stepper::set_usl_light_thresholds).
-inline constexpr double kSliverMassFraction = 1e-6;
-
 // At a node, a field of at most this fraction of the lightest particle's
-// mass is empty to the grid update, which forms no velocity for it
-// (Stepper::setup says why so small), and to an interface, which bonds every
-// field above it (MMConfig::bond_threshold).
+// mass is empty (ALGORITHM §4.3): the grid update forms no velocity for it
+// (Stepper::setup says why so small), and contact and interfaces leave it
+// out (MultimaterialStage::setup says why the same).
 inline constexpr double kEmptyMassFraction = 1e-15;
+
+// USL only: at a node, a field of at most this fraction of the lightest
+// particle's mass (or the Courant-scaled mass of linear shapes) is a light
+// node, whose force the update leaves out (Stepper::set_usl_light_thresholds,
+// kernels/mm_left_out.hpp).
+inline constexpr double kSliverMassFraction = 1e-6;
 
 // A rigid partner whose nodal domain fills less than this fraction of a cell
 // is taken as absent at the node under the displacement (and extrapolated)
@@ -135,19 +135,6 @@ struct MMConfig {
   // (Σ S_ip A_p, as in P-19); use 1 when grid.vol already holds A_p·t.
   Real thickness = 1;
   Real mass_threshold = 0;  // a field with m <= threshold is empty at the node
-  // Interface pairs only: a field above this mass is bonded to its interface
-  // partner even where it is a sliver (m <= mass_threshold). Where it is not
-  // below mass_threshold, no field is bonded as a sliver. Why: an interface
-  // holds at every node both materials reach. Screened, a light material's
-  // sliver at the node past the interface row moved on its own: a perfect
-  // interface between bars of density ratio 1e3 let the light bar's last row
-  // lag at 0.86 of its strain, 0.012 at 1e5 (docs/interface_validation.md
-  // Finding 13). MultimaterialStage sets the grid's own threshold, the mass
-  // below which a field has no velocity.
-  Real bond_threshold = std::numeric_limits<Real>::max();
-  // The lightest field a node's pass reads: a sliver may be bonded.
-  Real listed_threshold() const { return std::min(mass_threshold, bond_threshold); }
-  bool bonds_slivers() const { return bond_threshold < mass_threshold; }
   // Include Δf_i of (P-27) from grid.f in the force limit and in the exact integration.
   // Off by default (ALGORITHM §2: neglected in pass A).
   bool use_force_difference = false;

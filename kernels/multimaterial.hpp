@@ -586,37 +586,6 @@ void gather_node(const GridView<D, Real>& grid, std::size_t node, Real mass_thre
   }
 }
 
-// Whether fields fa and fb interact at a node where one of them is a sliver
-// (m <= cfg.mass_threshold): only an interface bonds it (MMConfig::bond_threshold).
-template <int D, class Real>
-inline bool bonds_sliver(const MMConfig<D, Real>& cfg, int fa, int fb) {
-  const int idx = cfg.pair[fa * cfg.fields + fb];
-  return idx >= 0 && cfg.params[idx].law == Law::interface;
-}
-
-// After gather_node at cfg.listed_threshold(): drops each sliver that no
-// other field at the node bonds to, so contact sees the node as it would at
-// cfg.mass_threshold.
-template <int D, class Real>
-void drop_unbonded_slivers(const MMConfig<D, Real>& cfg, NodeFields<D, Real>& nf) {
-  bool keep[kMaxFields];
-  for (int i = 0; i < nf.count; ++i) {
-    keep[i] = nf.side[i].m > cfg.mass_threshold;
-    for (int j = 0; j < nf.count && !keep[i]; ++j)
-      keep[i] = j != i && bonds_sliver(cfg, nf.field[i], nf.field[j]);
-  }
-  int kept = 0;
-  for (int i = 0; i < nf.count; ++i) {
-    if (!keep[i]) continue;
-    if (kept != i) {
-      nf.field[kept] = nf.field[i];
-      nf.side[kept] = nf.side[i];
-    }
-    ++kept;
-  }
-  nf.count = kept;
-}
-
 template <int D, class Real>
 inline void add_in_place(MaterialSide<D, Real>& lump, const MaterialSide<D, Real>& s) {
   lump.m += s.m;
@@ -673,8 +642,7 @@ void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::si
                   const SavedGeometry<D, Real>* geometry_in, SavedGeometry<D, Real>* geometry_out,
                   bool strain_pass, ChunkStats& cs) {
   const int F = cfg.fields;
-  gather_node<D, Real>(grid, node, cfg.listed_threshold(), needs, nf);
-  if (cfg.bonds_slivers()) drop_unbonded_slivers<D, Real>(cfg, nf);
+  gather_node<D, Real>(grid, node, cfg.mass_threshold, needs, nf);
   const int K = nf.count;
   if (K < 2) return;
   if constexpr (kPassA) (K == 2 ? cs.nodes_2 : cs.nodes_3plus) += 1;
@@ -748,12 +716,6 @@ void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::si
     return;
   }
 
-  // A pair with a sliver (kept by drop_unbonded_slivers) meets only when bonded.
-  auto meets = [&](int ia, int ib) {
-    return (nf.side[ia].m > cfg.mass_threshold && nf.side[ib].m > cfg.mass_threshold) ||
-           bonds_sliver(cfg, nf.field[ia], nf.field[ib]);
-  };
-
   // §6, three or more materials: each deformable a against the lump of its partners
   // (or against its rigid partner), all computed from the gathered snapshot, applied after.
   VecD<D, Real> change[kMaxFields], force[kMaxFields];
@@ -774,7 +736,6 @@ void process_node(GridView<D, Real>& grid, const MMConfig<D, Real>& cfg, std::si
     int largest_rigid = -1, largest_other = -1;
     for (int ib = 0; ib < K; ++ib) {
       if (ib == ia || !params_of(fa, nf.field[ib])) continue;
-      if (!meets(ia, ib)) continue;
       if (is_rigid(nf.field[ib])) {
         if (largest_rigid < 0 || nf.side[ib].vol > nf.side[largest_rigid].vol) largest_rigid = ib;
       } else {
@@ -843,18 +804,14 @@ void sort_chunk(const GridView<D, Real>& grid, const MMConfig<D, Real>& cfg,
     lane_of[k - begin] = -1;
     const std::size_t node = list[k];
     int K = 0, fa = -1, fb = -1;
-    bool sliver = false;  // m <= mass_threshold: met only by a bond (drop_unbonded_slivers)
     for (int j = 0; j < F; ++j) {
-      const Real m = grid.m[grid.at(j, node)];
-      if (!(m > cfg.listed_threshold())) continue;
-      sliver |= !(m > cfg.mass_threshold);
+      if (!(grid.m[grid.at(j, node)] > cfg.mass_threshold)) continue;
       (K == 0 ? fa : fb) = j;
       if (++K > 2) break;
     }
     if (K != 2 || is_rigid(fa) || is_rigid(fb)) continue;
     const int idx = cfg.pair[fa * F + fb];
     if (idx < 0 || cfg.params[idx].law == Law::separate) continue;
-    if (sliver && cfg.params[idx].law != Law::interface) continue;
     if (!batchable_pair(cfg.params[idx], kPassA)) continue;
     if (B.count == 0) {
       B.field_a = fa;

@@ -122,7 +122,7 @@ TEST(MirrorMultimaterial, HalfBondedBarsStepLikeTheWholeBars) {
     EXPECT_GT(r.s_max, 1e-3) << label;  // loaded by then
     // uGIMP's interface: its particles reach the node rows past the
     // interface and the mirror with weights down to 1e-15, and an interface
-    // bonds those slivers (MMConfig::bond_threshold), whose force-limit test
+    // bonds those slivers (MultimaterialStage::setup), whose force-limit test
     // (limited, or the spring) the two models' round-off can decide apart:
     // measured 2.2e-8 of the largest stress at 0.02 ms, 7.9e-9 at 0.2, and
     // 1.4e-10 with force_limit = false (1e-10 before the slivers were bonded).

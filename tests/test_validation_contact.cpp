@@ -1630,5 +1630,49 @@ TEST(ValidationContactLong, DiskOnInclineRefined) {
   }
 }
 
+// Two blocks stuck under shear and pressure do not creep (uGIMP, stick,
+// specified normal). shear_blocks.toml (lower E = 2400, nu = 0.33; upper
+// E = 1200, nu = 0.2; h = 0.5 mm, the contact on the grid line y = 2) with
+// its interface replaced by stick contact, the top loaded by tau = 0.001 and
+// -0.01 MPa (pressed shut), damped at 20 /ms. The rows next to the contact
+// (y0 = 1.875 and 2.125) then differ by the shear strain's 0.125 tau (1/G1
+// + 1/G2) = 3.885e-7 mm. While contact left out fields below 1e-6 of the
+// lightest particle, the slivers the pressed upper block put on the node row
+// below the contact moved on their own: the slip read 3.910e-7 at 0.5 ms
+// and crept to 3.954e-7 at 1.5 ms (4.016e-7 at 3 ms). Now every field the
+// grid gives a velocity takes part (MultimaterialStage::setup): 3.8904e-7
+// and 3.8928e-7 (docs/contact_validation.md §24). Tolerances: the slip
+// within 0.5 % of the shear strain's at 1.5 ms, and its growth from 0.5 to
+// 1.5 ms below 0.2 % of it.
+TEST(ValidationContact, StuckShearBlocksDoNotCreep) {
+  std::string scene = mmpm_test::read_text(input("shear_blocks.toml"));
+  const std::size_t from = scene.find("[[interaction]]"), to = scene.find("[[boundary]]");
+  ASSERT_TRUE(from != std::string::npos && to != std::string::npos && from < to);
+  scene.replace(from, to - from,
+                "[[interaction]]\nmaterials = [\"lower\", \"upper\"]\nlaw = \"stick\"\n"
+                "normal = \"specified\"\nnormal_vector = [0.0, 1.0]\n");
+  const double tau = 0.001, G1 = 2400 / (2 * 1.33), G2 = 1200 / (2 * 1.2);
+  auto sim = testing::make_from_text(
+      scene, {"load[0].traction=[" + num(tau) + ",-0.01]", "grid.damping=20.0"});
+  const auto slip = [&] {
+    const testing::Column x = field(*sim, "position"), u = field(*sim, "displacement");
+    double sum[2] = {0, 0}, count[2] = {0, 0};
+    for (std::size_t p = 0; p < sim->particle_count(); ++p) {
+      const double y0 = x.at(p, 1) - u.at(p, 1);
+      for (int r = 0; r < 2; ++r)
+        if (std::abs(y0 - (r == 0 ? 1.875 : 2.125)) < 1e-6) sum[r] += u.at(p, 0), count[r] += 1;
+    }
+    return sum[1] / count[1] - sum[0] / count[0];
+  };
+  testing::run_until(*sim, 0.5);
+  const double early = slip();
+  testing::run_until(*sim, 1.5);
+  const double late = slip(), exact = 0.125 * tau * (1 / G1 + 1 / G2);
+  note("[stuck shear] slip %.5g at 0.5 ms, %.5g at 1.5 ms, shear strain's %.5g", early, late,
+       exact);
+  EXPECT_NEAR(late / exact, 1.0, 0.005);
+  EXPECT_LT(std::abs(late - early), 0.002 * exact);
+}
+
 }  // namespace
 }  // namespace mmpm

@@ -1182,7 +1182,7 @@ TEST(ValidationInterface, SeriesBarsExactSpringAtRestReadsTheInterfaceEnergy) {
 // and the row lagged: 0.950 (ratio 1e3) and 0.265 (1e5) of sigma y / E at
 // 1 ms, 0.86 and 0.012 at 3 ms (an outside review; docs/interface_validation.md
 // Finding 13). Now an interface bonds every field the grid gives a velocity
-// (MMConfig::bond_threshold): 1.0011 at 1 ms for both ratios, the shared
+// (MultimaterialStage::setup): 1.0011 at 1 ms for both ratios, the shared
 // field's digits. Tolerances: the shared field within 1e-4 of its value
 // (round-off and the pass's order), sigma y / E within 0.3 % (at 1 ms the
 // damped bars are 0.1 % from rest). Under pure FLIP the unbonded slivers

@@ -87,11 +87,18 @@ class MultimaterialStage {
     cfg_.params = params_.data();
     cfg_.rigid = rigid_.data();
     cfg_.thickness = D == 2 ? Real(scene.simulation.thickness) : Real(1);
-    // Contact and interfaces ignore a material whose nodal mass is a sliver
-    // (ALGORITHM §4.3): 1e-6 of the lightest particle, well above round-off.
-    cfg_.mass_threshold = min_particle_mass * Real(kSliverMassFraction);
-    // Interfaces bond every field the grid gives a velocity (MMConfig::bond_threshold).
-    if (has_interface_) cfg_.bond_threshold = min_particle_mass * Real(kEmptyMassFraction);
+    // Every field the grid gives a velocity takes part in its pairs (ALGORITHM
+    // §4.3: the grid's own threshold). A uGIMP particle whose domain has just
+    // crossed a grid line reaches the next node row with a weight of
+    // (e/h)^2 / 2; left out of the pair, such a sliver moved with its own f/m
+    // and its particle took an increment of the order of the weight's
+    // gradient. At 1e-6 of the lightest particle (until 2026-12-07) a perfect
+    // interface let a light bar's last row lag at 0.86 of its strain (density
+    // ratio 1e3; 0.012 at 1e5), and a stuck contact's slip crept 2.7 % in
+    // 2.5 ms (docs/interface_validation.md Finding 13,
+    // docs/contact_validation.md §24). Contact's presence tests screen by
+    // volume, not by this (kContactPresentFraction, kRigidPresentFraction).
+    cfg_.mass_threshold = min_particle_mass * Real(kEmptyMassFraction);
     cfg_.dt = Real(dt);
     // USF: pass A's momenta are the strain's velocities (docs/contact_validation.md §13).
     usf_ = scene.simulation.scheme == Scheme::USF;
@@ -128,10 +135,10 @@ class MultimaterialStage {
   void find_nodes(const GridView<D, Real>& grid, const NodeOwnership& own,
                   const MixedTiles<D>* mixed = nullptr) {
     if (!enabled_) return;
-    find_multimaterial_nodes(grid, cfg_.listed_threshold(), list_, own, mixed);
+    find_multimaterial_nodes(grid, cfg_.mass_threshold, list_, own, mixed);
   }
   const std::vector<std::uint32_t>& nodes() const { return list_; }
-  Real listed_threshold() const { return cfg_.listed_threshold(); }
+  Real mass_threshold() const { return cfg_.mass_threshold; }
 
   // After find_nodes and the multimaterial fields' P2G.
   // limit_dt: the step the stick decisions are made for (MMConfig::limit_dt;

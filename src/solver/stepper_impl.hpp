@@ -242,8 +242,8 @@ void Stepper<D, Shape, Real>::setup_particles(const ParticleSeeds& seeds) {
   // it dropped nodes whose weight gradient is ~sqrt(S) ~ 3e-5 / h (uGIMP's
   // support edge), and a block translating diagonally took a spurious
   // strain (stress 8e-9 MPa at E = 100 after two steps, velocity error
-  // 1.4e-8; Extremes.TranslationIsExactForEveryShape). Contact keeps its
-  // own, larger threshold; interfaces bond at this one (MultimaterialStage::setup).
+  // 1.4e-8; Extremes.TranslationIsExactForEveryShape). Contact and
+  // interfaces use the same (MultimaterialStage::setup).
   mass_threshold_ = Real(kEmptyMassFraction * min_mass);
   min_particle_mass_ = min_mass;
   set_usl_light_thresholds(seeds);
@@ -693,7 +693,7 @@ void Stepper<D, Shape, Real>::p2g_multimaterial() {
   if (moments_.enabled()) {  // separation = "extrapolated": mx from the centroids to the nodes
     const std::size_t bad = extrapolate_separation<D, Shape, Real>(
         P_, G_, moments_, schedule_, reach_tiles_, mirrored ? extrapolated_nodes_ : mm_.nodes(),
-        plan_.rigid.data(), mm_.listed_threshold(), separation_listed_, particles_on_team());
+        plan_.rigid.data(), mm_.mass_threshold(), separation_listed_, particles_on_team());
     if (bad != SIZE_MAX) fail_particle("p2g", bad, "its shape-function stencil left the grid");
   }
   if (mirrored) fold_mirrors_multimaterial();
