@@ -1645,24 +1645,17 @@ TEST(ValidationContactLong, DiskOnInclineRefined) {
 // within 0.5 % of the shear strain's at 1.5 ms, and its growth from 0.5 to
 // 1.5 ms below 0.2 % of it.
 TEST(ValidationContact, StuckShearBlocksDoNotCreep) {
-  std::string scene = mmpm_test::read_text(input("shear_blocks.toml"));
-  const std::size_t from = scene.find("[[interaction]]"), to = scene.find("[[boundary]]");
-  ASSERT_TRUE(from != std::string::npos && to != std::string::npos && from < to);
-  scene.replace(from, to - from,
-                "[[interaction]]\nmaterials = [\"lower\", \"upper\"]\nlaw = \"stick\"\n"
-                "normal = \"specified\"\nnormal_vector = [0.0, 1.0]\n");
+  const std::string scene = testing::replace_between(
+      mmpm_test::read_text(input("shear_blocks.toml")), "[[interaction]]", "[[boundary]]",
+      "[[interaction]]\nmaterials = [\"lower\", \"upper\"]\nlaw = \"stick\"\n"
+      "normal = \"specified\"\nnormal_vector = [0.0, 1.0]\n");
   const double tau = 0.001, G1 = 2400 / (2 * 1.33), G2 = 1200 / (2 * 1.2);
   auto sim = testing::make_from_text(
       scene, {"load[0].traction=[" + num(tau) + ",-0.01]", "grid.damping=20.0"});
+  // The rows next to the contact.
   const auto slip = [&] {
-    const testing::Column x = field(*sim, "position"), u = field(*sim, "displacement");
-    double sum[2] = {0, 0}, count[2] = {0, 0};
-    for (std::size_t p = 0; p < sim->particle_count(); ++p) {
-      const double y0 = x.at(p, 1) - u.at(p, 1);
-      for (int r = 0; r < 2; ++r)
-        if (std::abs(y0 - (r == 0 ? 1.875 : 2.125)) < 1e-6) sum[r] += u.at(p, 0), count[r] += 1;
-    }
-    return sum[1] / count[1] - sum[0] / count[0];
+    return testing::row_mean_displacement(*sim, 2.125, 0) -
+           testing::row_mean_displacement(*sim, 1.875, 0);
   };
   testing::run_until(*sim, 0.5);
   const double early = slip();

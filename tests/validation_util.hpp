@@ -11,6 +11,7 @@
 #include <cstring>
 #include <map>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -42,6 +43,18 @@ inline void run_until(Simulation& sim, double t_end) {
   while (sim.time() < t_end - 1e-9 * sim.dt()) sim.step();
 }
 
+// `text` with the part from the first `begin` up to the first `end` after it
+// replaced by `with`: a shipped scene with one of its blocks swapped (say its
+// [[interaction]], up to the next [[boundary]]). Throws when either is missing.
+inline std::string replace_between(std::string text, const std::string& begin,
+                                   const std::string& end, const std::string& with) {
+  const std::size_t from = text.find(begin);
+  const std::size_t to = from == std::string::npos ? from : text.find(end, from);
+  if (to == std::string::npos)
+    throw std::runtime_error("replace_between: '" + begin + "' ... '" + end + "' not found");
+  return text.replace(from, to - from, with);
+}
+
 struct Column {
   std::vector<double> values;
   int components = 1;
@@ -53,6 +66,16 @@ struct Column {
 inline Column field(const Simulation& sim, const std::string& name) {
   auto f = sim.particle_field(name);
   return {std::move(f.values), f.components};
+}
+
+// The mean of displacement component c over the particles seeded at height
+// y0 (2D: y of position − displacement), as a row of a box of particles.
+inline double row_mean_displacement(const Simulation& sim, double y0, int c) {
+  const Column x = field(sim, "position"), u = field(sim, "displacement");
+  double sum = 0, count = 0;
+  for (std::size_t p = 0; p < sim.particle_count(); ++p)
+    if (std::abs(x.at(p, 1) - u.at(p, 1) - y0) < 1e-6) sum += u.at(p, c), count += 1;
+  return sum / count;
 }
 
 // A model on mirror planes against the whole body it mirrors: the largest
