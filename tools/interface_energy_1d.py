@@ -32,94 +32,107 @@ import argparse
 import numpy as np
 
 
-def run(a):
-    h, E, rho = a.h, a.E, 1e-3
-    dx = h / a.ppc
-    x = [np.arange(dx / 2, a.cells * h, dx)]
-    x.append(x[0] + a.cells * h)
-    u = [np.zeros_like(x[0]), np.zeros_like(x[1])]
-    x_ref = [x[0].copy(), x[1].copy()]
-    v = [np.full_like(x[0], a.v0), np.full_like(x[1], -a.v0)]
-    s = [np.zeros_like(x[0]), np.zeros_like(x[1])]
-    Vp = dx
-    mp = rho * Vp
-    dt = a.cfl * h / np.sqrt(E / rho)
-    pad = int(np.ceil(a.v0 * a.end / h)) + 2
-    nn = 2 * a.cells + 1 + 2 * pad
-    x0n = -pad * h
-    hist = np.zeros(nn)
+class Bars:
+    """The two bars' constants: seeds, particle mass and volume, the step and the grid."""
 
-    def weights(xp):
-        i = np.floor((xp - x0n) / h).astype(int)
-        f = (xp - x0n) / h - i
-        return i, np.stack([1 - f, f], 1), np.stack([-np.ones_like(f) / h, np.ones_like(f) / h], 1)
+    def __init__(self, a):
+        self.h, self.E, self.Dn = a.h, a.E, a.Dn
+        dx = a.h / a.ppc
+        seeds = np.arange(dx / 2, a.cells * a.h, dx)
+        self.X = [seeds, seeds + a.cells * a.h]
+        self.Vp = dx
+        self.mp = 1e-3 * dx  # density 1e-3
+        self.dt = a.cfl * a.h / np.sqrt(a.E / 1e-3)
+        pad = int(np.ceil(a.v0 * getattr(a, "end", 0.0) / a.h)) + 2
+        self.nodes = 2 * a.cells + 1 + 2 * pad
+        self.origin = -pad * a.h
 
-    def scatter(i, w, q):
-        out = np.zeros(nn)
-        for k in range(2):
-            np.add.at(out, i + k, w[:, k] * q)
-        return out
+    def weights(self, x):
+        """Linear shape functions S and their gradients, particles x nodes."""
+        t = (x - self.origin) / self.h
+        i = np.floor(t).astype(int)
+        f = t - i
+        W = np.zeros((len(x), self.nodes))
+        G = np.zeros((len(x), self.nodes))
+        rows = np.arange(len(x))
+        W[rows, i], W[rows, i + 1] = 1 - f, f
+        G[rows, i], G[rows, i + 1] = -1 / self.h, 1 / self.h
+        return W, G
 
-    def gather(i, w, g):
-        return (w * g[np.stack([i, i + 1], 1)]).sum(1)
 
-    energies = []
-    for step in range(int(a.end / dt)):
-        if step > 0 and any(xj.min() < x0n + h or xj.max() > x0n + (nn - 2) * h for xj in x):
-            raise SystemExit(f"diverged: a particle left the grid at t = {step * dt:.4g} ms "
-                             f"(energy {energies[-1] / energies[0]:.3g} E0)")
-        fields = []
-        for j in range(2):
-            i, w, g = weights(x[j])
-            m = scatter(i, w, np.full_like(x[j], mp))
-            fields.append(dict(i=i, w=w, g=g, m=m, p=scatter(i, w, mp * v[j]),
-                               mu=scatter(i, w, mp * u[j]), vol=scatter(i, w, np.full_like(x[j], Vp)),
-                               f=sum(np.bincount(i + k, -g[:, k] * Vp * s[j], minlength=nn)
-                                     for k in range(2))))
-        a_, b_ = fields
-        both = (a_["m"] > 0) & (b_["m"] > 0)
-        safe = lambda q: np.where(both, q, 1.0)
-        delta = np.where(both, b_["mu"] / safe(b_["m"]) - a_["mu"] / safe(a_["m"]), 0.0)
-        if a.delta == "nodal":
-            delta = np.where(both, hist, 0.0)
-        area = np.where(both, np.sqrt(2 * (a_["vol"] + b_["vol"]) * np.minimum(a_["vol"], b_["vol"])) / h, 0.0)
-        F = a.Dn * area * delta  # on a, toward b (+x)
-        energy_int = 0.5 * (a.Dn * area * delta ** 2).sum()
-        fi = [F, -F]
-        if a.force == "consistent":
-            for j, sign in ((0, 1.0), (1, -1.0)):
-                fl = fields[j]
-                share = sum(F[fl["i"] + k] * fl["w"][:, k] / np.where(fl["m"][fl["i"] + k] > 0, fl["m"][fl["i"] + k], 1)
-                            for k in range(2)) * mp
-                fi[j] = scatter(fl["i"], fl["w"], sign * share)
-        K = sum(0.5 * mp * (vj ** 2).sum() for vj in v)
-        U = sum(0.5 * Vp * (sj ** 2).sum() / E for sj in s)
-        energies.append(K + U + energy_int)
-        new_velocity = []
-        for j in range(2):
-            fl = fields[j]
-            ok = fl["m"] > 0
-            m = np.where(ok, fl["m"], 1.0)
-            v_old = np.where(ok, fl["p"] / m, 0.0)
-            v_new = np.where(ok, (fl["p"] + dt * (fl["f"] + fi[j])) / m, 0.0)
-            new_velocity.append(v_new)
-            i, w, g = fl["i"], fl["w"], fl["g"]
-            v_grid = gather(i, w, v_new)
-            v[j] = v[j] + gather(i, w, v_new - v_old)  # FLIP
-            x[j] = x[j] + dt * v_grid
-            if a.scheme == "usl":
-                u[j] = u[j] + dt * v_grid
-                rate = gather(i, g, v_new)
-            else:  # MUSL: strain from the velocities of the updated particles
-                mr = scatter(i, w, np.full_like(v[j], mp))
-                v_remap = np.where(mr > 0, scatter(i, w, mp * v[j]) / np.where(mr > 0, mr, 1.0), 0.0)
-                rate = gather(i, g, v_remap)
-                if a.displacement == "anchored":  # this step's start plus its remapped move
-                    u[j] = x[j] - dt * v_grid - x_ref[j] + dt * gather(i, w, v_remap)
-                else:
-                    u[j] = u[j] + dt * (gather(i, w, v_remap) if a.displacement == "remap" else v_grid)
-            s[j] = s[j] + dt * E * rate
+def step(bars, W, G, v, u, s, a, hist=None, start_displacement=None):
+    """One step of both bars on the weights W, G (one pair per bar).
+
+    Returns the new v, u, s, each particle's move, U_int before the step and
+    the nodal opening history (for --delta nodal). start_displacement (per
+    bar, x - x0 at the step's start) is read by --displacement anchored.
+    """
+    mp, Vp, dt = bars.mp, bars.Vp, bars.dt
+    m = [mp * W[j].sum(0) for j in range(2)]
+    vol = [Vp * W[j].sum(0) for j in range(2)]
+    both = (m[0] > 0) & (m[1] > 0)
+    safe = [np.where(m[j] > 0, m[j], 1.0) for j in range(2)]
+    mu = [W[j].T @ (mp * u[j]) for j in range(2)]
+    delta = np.where(both, mu[1] / safe[1] - mu[0] / safe[0], 0.0)
+    if a.delta == "nodal":
+        delta = np.where(both, hist, 0.0)
+    area = np.where(both, np.sqrt(2 * (vol[0] + vol[1]) * np.minimum(vol[0], vol[1])) / bars.h, 0.0)
+    F = bars.Dn * area * delta  # on a, toward b (+x)
+    energy_int = 0.5 * (bars.Dn * area * delta ** 2).sum()
+    fi = [F, -F]
+    if a.force == "consistent":  # -dE/du_p on the particles, scattered with S
+        fi = [sign * (W[j].T @ (mp * (W[j] @ (F / safe[j])))) for j, sign in ((0, 1.0), (1, -1.0))]
+    vn, un, sn, moves, new_velocity = [], [], [], [], []
+    for j in range(2):
+        ok = m[j] > 0
+        p = W[j].T @ (mp * v[j])
+        f = -G[j].T @ (Vp * s[j])
+        v_old = np.where(ok, p / safe[j], 0.0)
+        v_new = np.where(ok, (p + dt * (f + fi[j])) / safe[j], 0.0)
+        new_velocity.append(v_new)
+        v_particle = v[j] + W[j] @ (v_new - v_old)  # FLIP
+        move = dt * (W[j] @ v_new)
+        if a.scheme == "usl":
+            rate = G[j] @ v_new
+            u_new = u[j] + move
+        else:  # MUSL: the strain from the re-extrapolated velocity
+            v_remap = np.where(ok, (W[j].T @ (mp * v_particle)) / safe[j], 0.0)
+            rate = G[j] @ v_remap
+            remap_move = dt * (W[j] @ v_remap)
+            if a.displacement == "anchored":  # the step's start plus its remapped move
+                u_new = start_displacement[j] + remap_move
+            else:
+                u_new = u[j] + (remap_move if a.displacement == "remap" else move)
+        vn.append(v_particle)
+        un.append(u_new)
+        sn.append(s[j] + dt * bars.E * rate)
+        moves.append(move)
+    if hist is not None:
         hist = np.where(both, hist + dt * (new_velocity[1] - new_velocity[0]), 0.0)
+    return vn, un, sn, moves, energy_int, hist
+
+
+def run(a):
+    bars = Bars(a)
+    x = [X.copy() for X in bars.X]
+    u = [np.zeros_like(X) for X in bars.X]
+    v = [np.full_like(bars.X[0], a.v0), np.full_like(bars.X[1], -a.v0)]
+    s = [np.zeros_like(X) for X in bars.X]
+    hist = np.zeros(bars.nodes)
+    energies = []
+    for n in range(int(a.end / bars.dt)):
+        if n > 0 and any(xj.min() < bars.origin + bars.h or
+                         xj.max() > bars.origin + (bars.nodes - 2) * bars.h for xj in x):
+            raise SystemExit(f"diverged: a particle left the grid at t = {n * bars.dt:.4g} ms "
+                             f"(energy {energies[-1] / energies[0]:.3g} E0)")
+        WG = [bars.weights(xj) for xj in x]
+        K = sum(0.5 * bars.mp * (vj ** 2).sum() for vj in v)
+        U = sum(0.5 * bars.Vp * (sj ** 2).sum() / bars.E for sj in s)
+        start = [x[j] - bars.X[j] for j in range(2)]
+        v, u, s, moves, energy_int, hist = step(bars, [w for w, _ in WG], [g for _, g in WG], v, u, s,
+                                                a, hist, start)
+        energies.append(K + U + energy_int)
+        x = [x[j] + moves[j] for j in range(2)]
     e = np.array(energies)
     return e / e[0]
 
