@@ -462,4 +462,46 @@ inline double bulk_from_pressure(double P, double eps0) {
   return P / (3.0 * eps0);
 }
 
+// ---------------------------------------------------------------------------
+// §5c  A stress wave through a normal imperfect interface (dynamic)
+// ---------------------------------------------------------------------------
+
+/// A plane wave of particle velocity v_I(t) in bar 1 (impedance Z1 = rho1 c1
+/// [MPa ms/mm]) meets a normal interface Dn [MPa/mm] in front of bar 2 (Z2). The
+/// transmitted particle velocity obeys  v_T + tau dv_T/dt = T0 v_I  (V 5c.3) with
+/// T0 = 2 Z1/(Z1 + Z2) (the bonded transmission) and tau = Z1 Z2/(Dn (Z1 + Z2)) [ms]
+/// (V 5c.4); the reflected particle velocity is v_R = v_I - (Z2/Z1) v_T  (V 5c.2).
+/// Dn = inf gives tau = 0 (bonded); Dn = 0 gives tau = inf (nothing crosses).
+struct InterfaceWave {
+  double transmission = 0;  // T0
+  double tau = 0;           // ms
+};
+inline InterfaceWave interface_wave(double Z1, double Z2, double Dn) {
+  return {2.0 * Z1 / (Z1 + Z2), Z1 * Z2 / (Z1 + Z2) * compliance_of(Dn)};
+}
+
+/// Displacement [mm] carried past a point, s [ms] after the front arrives, by a
+/// wave whose particle velocity ramps linearly from 0 to v0 [mm/ms] over t_ramp
+/// [ms] and then holds, after a first-order lag tau [ms] (w + tau w' = v, w(0) = 0):
+///   s <= t_ramp:  W = a (s^2/2 - tau s + tau^2 (1 - e^(-s/tau))),  a = v0/t_ramp
+///   s >  t_ramp:  W = W(t_ramp) + v0 (s - t_ramp) + (w(t_ramp) - v0) tau (1 - e^(-(s -
+///   t_ramp)/tau)),
+///                 w(t_ramp) = a (t_ramp - tau + tau e^(-t_ramp/tau))           (V 5c.5)
+/// tau = 0 is the ramp itself, tau = inf carries nothing; zero for s <= 0. Late in
+/// the wave W -> v0 (s - t_ramp/2 - tau): the interface delays it by tau.
+inline double lagged_ramp_displacement(double s, double v0, double t_ramp, double tau) {
+  if (!(t_ramp > 0.0) || !(tau >= 0.0))
+    throw std::invalid_argument("lagged_ramp_displacement: t_ramp > 0 and tau >= 0");
+  if (s <= 0.0 || tau == kInf) return 0.0;
+  const double a = v0 / t_ramp;
+  auto rising = [&](double x) {  // W on [0, t_ramp]
+    return tau == 0.0 ? 0.5 * a * x * x
+                      : a * (0.5 * x * x - tau * x - tau * tau * std::expm1(-x / tau));
+  };
+  if (s <= t_ramp) return rising(s);
+  const double w_ramp = tau == 0.0 ? v0 : a * (t_ramp - tau + tau * std::exp(-t_ramp / tau));
+  const double settle = tau == 0.0 ? 0.0 : -tau * std::expm1(-(s - t_ramp) / tau);
+  return rising(t_ramp) + v0 * (s - t_ramp) + (w_ramp - v0) * settle;
+}
+
 }  // namespace mmpm::analytic

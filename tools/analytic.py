@@ -332,6 +332,28 @@ def bulk_from_pressure(P, eps0):
     return P / (3 * eps0)
 
 
+# --------------------------------------------------------------------------- §5c wave
+def interface_wave(Z1, Z2, Dn):
+    """(T0, tau): bonded transmission 2 Z1/(Z1+Z2) and lag Z1 Z2/(Dn (Z1+Z2)) [ms] (V 5c.4)"""
+    return 2 * Z1 / (Z1 + Z2), Z1 * Z2 / (Z1 + Z2) * compliance_of(Dn)
+
+
+def lagged_ramp_displacement(s, v0, t_ramp, tau):
+    """Displacement [mm] s [ms] after the front of a velocity ramp 0 -> v0 over t_ramp,
+    lagged by w + tau w' = v (V 5c.5); zero for s <= 0, tau = inf carries nothing."""
+    s = np.maximum(np.asarray(s, dtype=float), 0.0)
+    if tau == INF:
+        return np.zeros_like(s)
+    a = v0 / t_ramp
+    if tau == 0.0:
+        return np.where(s <= t_ramp, 0.5 * a * s * s, v0 * (s - 0.5 * t_ramp))
+    x = np.minimum(s, t_ramp)
+    rising = a * (0.5 * x * x - tau * x - tau * tau * np.expm1(-x / tau))
+    w_ramp = a * (t_ramp - tau + tau * np.exp(-t_ramp / tau))
+    after = np.maximum(s - t_ramp, 0.0)
+    return rising + v0 * after + (w_ramp - v0) * (-tau * np.expm1(-after / tau))
+
+
 # --------------------------------------------------------------------------- paper data
 GLASS = dict(E=70000.0, nu=0.25)
 POLYMER = dict(E=2400.0, nu=0.33)
@@ -431,6 +453,19 @@ def selftest() -> int:
     ok &= _close("CSA midpoint", csa_bulk(Ki, Km, Gm, PHI_PAPER, 0.7, 1 / mid),
                  0.5 * (csa_bulk_perfect(Ki, Km, Gm, PHI_PAPER) + csa_bulk_void(Km, Gm, PHI_PAPER)),
                  rtol=1e-10)
+    # §5c: the closed form against a direct integration of w + tau w' = v.
+    v0, tr, tau = 0.01, 0.002, 0.005
+    ds = 1e-7
+    tt = np.arange(0, 0.03, ds)
+    vin = v0 * np.minimum(tt / tr, 1.0)
+    w = np.zeros_like(tt)
+    for k in range(1, len(tt)):
+        w[k] = vin[k] + (w[k - 1] - vin[k]) * np.exp(-ds / tau)
+    W = np.concatenate(([0.0], np.cumsum(0.5 * (w[1:] + w[:-1]) * ds)))
+    ok &= bool(np.max(np.abs(lagged_ramp_displacement(tt, v0, tr, tau) - W)) < 1e-4 * W[-1])
+    ok &= _close("wave late lag", float(lagged_ramp_displacement(0.2, v0, tr, tau)),
+                 v0 * (0.2 - tr / 2 - tau), rtol=1e-12)
+    ok &= _close("wave T0 tau", interface_wave(1.0, 2.0, 100.0)[1], 2.0 / 300.0)
     print("selftest: OK" if ok else "selftest: FAILED")
     return 0 if ok else 1
 
