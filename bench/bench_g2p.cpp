@@ -189,9 +189,11 @@ void bm_xpic_interpolation(benchmark::State& state, int threads) {
     team_for(n >= kParallelMin, chunks, [&](std::size_t c) {
       const std::size_t b = c * kReduceChunk, e = std::min(n, b + kReduceChunk);
       if constexpr (Kernel == Interpolation::windowed)
-        stopped[c] = interpolate_to_particles_windowed<D, Shape, Real>(P, G, u, out, b, e) - e;
+        stopped[c] =
+            interpolate_to_particles_windowed<D, Shape, Real>(P, G, u, into_arrays(out), b, e) - e;
       else
-        stopped[c] = interpolate_to_particles_pointwise<D, Shape, Real>(P, G, u, out, b, e) - e;
+        stopped[c] =
+            interpolate_to_particles_pointwise<D, Shape, Real>(P, G, u, into_arrays(out), b, e) - e;
     });
     keep(out[0]);
     benchmark::ClobberMemory();

@@ -377,13 +377,15 @@ template <NormalMethod M, Law L, bool UseDf, ContactArea A, int D, class Real>
           exceeds_force_limit(fn, force_limit_component(m_red, dt, dn, dp_n, dot<D, Real>(df, n)));
       const bool over_t = exceeds_force_limit(
           ft, force_limit_component(m_red, dt, delta_t, dot<D, Real>(dp, t), dot<D, Real>(df, t)));
+      const bool stiff_n = spring_beyond_one_step(fn, m_red, dt, dn);
+      const bool stiff_t = spring_beyond_one_step(ft, m_red, dt, delta_t);
       // The direction flags as 0/1 Reals: boolean algebra over these lane
       // conditions became selects between booleans in GCC 12, which its
       // vectoriser rejects; products and sums of Reals do not.
       const Real one = 1, none = 0, limiting = force_limit ? one : none;
       const Real pn = perfect_n ? one : none, pt = perfect_t ? one : none;
-      const Real ln = (one - pn) * limiting * (over_n ? one : none);
-      const Real lt = (one - pt) * limiting * (over_t ? one : none);
+      const Real ln = (one - pn) * limiting * (over_n ? one : none) * (stiff_n ? one : none);
+      const Real lt = (one - pt) * limiting * (over_t ? one : none) * (stiff_t ? one : none);
       const Real st = pt + lt;  // stick: perfect or limited (exclusive)
       // A perfect compression branch of the bilinear law is one-sided
       // (kOneSidedNormal, docs/multimaterial.md §4.1): it sticks only while the

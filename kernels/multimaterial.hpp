@@ -352,7 +352,8 @@ DirectionOutcome<Real> interface_direction(const PairParams<Real>& pp, bool perf
   const Real force = traction * area;
   if (pp.force_limit &&
       exceeds_force_limit(
-          force, force_limit_component(m_red, limit_dt, separation, momentum_change, force_diff))) {
+          force, force_limit_component(m_red, limit_dt, separation, momentum_change, force_diff)) &&
+      spring_beyond_one_step(force, m_red, limit_dt, separation)) {
     o.stick = o.limited = true;
     return o;
   }

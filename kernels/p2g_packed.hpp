@@ -74,6 +74,8 @@ struct PackedSource {
         S u = opt.position_separation ? x : x - lanes_of<Full>(P.x0[d], p, count);
         if constexpr (std::is_same_v<Real, float>)  // separation_coordinate, K lanes
           if (!opt.position_separation && P.xlo[0]) u += lanes_of<Full>(P.xlo[d], p, count);
+        if (!opt.position_separation && P.sep_shift[0])
+          u += lanes_of<Full>(P.sep_shift[d], p, count);
         q.mw[d] = q.m * u;
       }
     }

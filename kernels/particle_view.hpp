@@ -50,6 +50,9 @@ struct ParticleView {
   // float only: the low part of x, what x could not hold of the moves so far
   // (kernels/position_sum.hpp); the position is x + xlo. Null in double.
   std::array<Real*, D> xlo{};
+  // MUSL with an imperfect interface only: what the displacement the
+  // separation reads has moved beyond x - x0 (kernels/separation_shift.hpp).
+  std::array<Real*, D> sep_shift{};
 };
 
 // A column pointer q with q[p] = block[p - first] for p >= first, so a

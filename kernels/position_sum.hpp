@@ -38,7 +38,8 @@ template <class T>
 // Particle p's coordinate d that the multimaterial separation is built from
 // (ALGORITHM §1, w_p of mx): x with the position method, else the displacement
 // x - x0, which in float also takes xlo (x - x0 of two nearby floats is
-// exact, so the displacement is then as precise as the position sum).
+// exact, so the displacement is then as precise as the position sum), and
+// under MUSL with an interface the shift of kernels/separation_shift.hpp.
 template <int D, class Real>
 [[gnu::always_inline]] inline Real separation_coordinate(const ParticleView<D, Real>& P,
                                                          bool position, int d, std::size_t p) {
@@ -46,6 +47,7 @@ template <int D, class Real>
   Real u = P.x[d][p] - P.x0[d][p];
   if constexpr (std::is_same_v<Real, float>)
     if (P.xlo[0]) u += P.xlo[d][p];
+  if (P.sep_shift[0]) u += P.sep_shift[d][p];
   return u;
 }
 

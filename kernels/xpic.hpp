@@ -33,12 +33,11 @@ namespace mmpm {
 // particles [begin, end), node by node on each particle's stencil: the
 // reference, and the path for grids too small for a window. Returns the
 // first particle whose stencil leaves the grid (its out_p untouched), or end.
-template <int D, class Shape, class Real>
+template <int D, class Shape, class Real, class Sink>
 std::size_t interpolate_to_particles_pointwise(const ParticleView<D, Real>& P,
                                                const GridView<D, Real>& G,
-                                               const std::array<const Real*, D>& u,
-                                               const std::array<Real*, D>& out, std::size_t begin,
-                                               std::size_t end) {
+                                               const std::array<const Real*, D>& u, Sink&& sink,
+                                               std::size_t begin, std::size_t end) {
   const std::array<Real, 3> inv_h{Real(1) / G.h[0], Real(1) / G.h[1], Real(1) / G.h[2]};
   Stencil<D, Shape, Real> st{};
   for (std::size_t p = begin; p < end; ++p) {
@@ -47,7 +46,7 @@ std::size_t interpolate_to_particles_pointwise(const ParticleView<D, Real>& P,
     Real s[D] = {};
     for (int k = 0; k < st.count; ++k)
       for (int d = 0; d < D; ++d) s[d] += st.w[k] * u[d][b + st.node[k]];
-    for (int d = 0; d < D; ++d) out[d][p] = s[d];
+    sink(p, s);
   }
   return end;
 }
@@ -65,12 +64,11 @@ std::size_t interpolate_to_particles_pointwise(const ParticleView<D, Real>& P,
 // gather of u twice, was 6-16 % slower: it sums the change too. Holding a
 // window's grid values for the particles that share it gained nothing
 // (4.92 -> 5.01 ns, uGIMP).
-template <int D, class Shape, class Real>
+template <int D, class Shape, class Real, class Sink>
 std::size_t interpolate_to_particles_windowed(const ParticleView<D, Real>& P,
                                               const GridView<D, Real>& G,
-                                              const std::array<const Real*, D>& u,
-                                              const std::array<Real*, D>& out, std::size_t begin,
-                                              std::size_t end) {
+                                              const std::array<const Real*, D>& u, Sink&& sink,
+                                              std::size_t begin, std::size_t end) {
   using Win = Window<D, Shape, Real>;
   using Vec = typename Win::V;
   const WindowBuilder<D, Shape, Real> builder(G);
@@ -96,9 +94,13 @@ std::size_t interpolate_to_particles_windowed(const ParticleView<D, Real>& P,
       V4 f[3] = {};
       for (int d = 0; d < D; ++d) f[d] = lanes_fold4<Real, Win::L>(X * A[d]);
       const V4 sums = lanes_sum4(f[0], f[1], f[2], V4{});
-      for (int d = 0; d < D; ++d) out[d][p] = sums[d];
+      Real s[D];
+      for (int d = 0; d < D; ++d) s[d] = sums[d];
+      sink(p, s);
     } else {
-      for (int d = 0; d < D; ++d) out[d][p] = lanes_sum<Real, Win::L>(X * A[d]);
+      Real s[D];
+      for (int d = 0; d < D; ++d) s[d] = lanes_sum<Real, Win::L>(X * A[d]);
+      sink(p, s);
     }
     return true;
   };
@@ -106,14 +108,32 @@ std::size_t interpolate_to_particles_windowed(const ParticleView<D, Real>& P,
 }
 
 // The solver's interpolation: windowed where the grid holds a window.
+// sink(p, sums) takes particle p's D sums (sums[d] = out_p along d).
+template <int D, class Shape, class Real, class Sink>
+std::size_t interpolate_to_particles_into(const ParticleView<D, Real>& P,
+                                          const GridView<D, Real>& G,
+                                          const std::array<const Real*, D>& u, Sink&& sink,
+                                          std::size_t begin, std::size_t end) {
+  if (Window<D, Shape, Real>::fits(G))
+    return interpolate_to_particles_windowed<D, Shape, Real>(P, G, u, sink, begin, end);
+  return interpolate_to_particles_pointwise<D, Shape, Real>(P, G, u, sink, begin, end);
+}
+
+// A sink that stores the sums in D particle arrays: out[d][p] = sums[d].
+template <class Real, std::size_t D>
+auto into_arrays(const std::array<Real*, D>& out) {
+  return [out](std::size_t p, const Real* sums) __attribute__((always_inline)) {
+    for (std::size_t d = 0; d < D; ++d) out[d][p] = sums[d];
+  };
+}
+
+// The same into D particle arrays.
 template <int D, class Shape, class Real>
 std::size_t interpolate_to_particles(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
                                      const std::array<const Real*, D>& u,
                                      const std::array<Real*, D>& out, std::size_t begin,
                                      std::size_t end) {
-  if (Window<D, Shape, Real>::fits(G))
-    return interpolate_to_particles_windowed<D, Shape, Real>(P, G, u, out, begin, end);
-  return interpolate_to_particles_pointwise<D, Shape, Real>(P, G, u, out, begin, end);
+  return interpolate_to_particles_into<D, Shape, Real>(P, G, u, into_arrays(out), begin, end);
 }
 
 // One more term of the series at nodes [begin, end): with q = S^T M_p S term

@@ -85,8 +85,10 @@ TYPED_TEST(XpicInterpolation, WindowedEqualsTheStencilsSum) {
     storage.assign(std::size_t(D) * n, Real(-7));
     std::array<Real*, D> out;
     for (int d = 0; d < D; ++d) out[d] = storage.data() + std::size_t(d) * n;
-    return windowed ? interpolate_to_particles_windowed<D, Shape, Real>(P, G, u, out, 0, end)
-                    : interpolate_to_particles_pointwise<D, Shape, Real>(P, G, u, out, 0, end);
+    return windowed ? interpolate_to_particles_windowed<D, Shape, Real>(P, G, u, into_arrays(out),
+                                                                        0, end)
+                    : interpolate_to_particles_pointwise<D, Shape, Real>(P, G, u, into_arrays(out),
+                                                                         0, end);
   };
   std::vector<Real> win, ref;
   ASSERT_EQ(run(true, n, win), n);

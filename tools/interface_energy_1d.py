@@ -24,6 +24,15 @@ Variants that test a cause:
                        MUSL only: that displacement reset every step to the
                        particle's x - x0 at the step's start plus the step's
                        re-extrapolated move
+  --force-limit        the paper's clip (ALGORITHM 4.4): where the spring's
+                       force exceeds f_lim the node sticks (both fields'
+                       momenta to the centre of mass in pass A, outside the
+                       FLIP increment, and their velocities after the update
+                       and on MUSL's re-extrapolated velocities) and stores no
+                       energy
+  --limit-gate         with --force-limit: clip only a spring beyond the one-step
+                       bound, D A dt^2 > 2 m_red (omega dt > sqrt 2), as the
+                       solver does (docs/multimaterial.md 8.1)
 
 Usage: /usr/bin/python3 tools/interface_energy_1d.py --Dn 100 --ppc 2 --end 3
 """
@@ -78,25 +87,52 @@ def step(bars, W, G, v, u, s, a, hist=None, start_displacement=None):
         delta = np.where(both, hist, 0.0)
     area = np.where(both, np.sqrt(2 * (vol[0] + vol[1]) * np.minimum(vol[0], vol[1])) / bars.h, 0.0)
     F = bars.Dn * area * delta  # on a, toward b (+x)
-    energy_int = 0.5 * (bars.Dn * area * delta ** 2).sum()
+    limited = np.zeros(bars.nodes, dtype=bool)
+    if a.force_limit:  # ALGORITHM 4.4 (P-23..P-27), before the internal forces (pass A)
+        p0 = [W[j].T @ (mp * v[j]) for j in range(2)]
+        m_red = np.where(both, m[0] * m[1] / (safe[0] + safe[1]), 0.0)
+        dp_a = m_red * np.where(both, p0[1] / safe[1] - p0[0] / safe[0], 0.0)
+        f_lim = 2 * m_red * delta / dt ** 2 + 2 * dp_a / dt
+        limited = both & (np.abs(F) > np.abs(f_lim))
+        if a.limit_gate:  # only a spring stiffer than the one-step bound (omega dt > sqrt 2)
+            limited &= np.abs(F) > np.abs(2 * m_red * delta / dt ** 2)
+        F = np.where(limited, 0.0, F)
+    energy_int = 0.5 * (bars.Dn * area * delta ** 2 * ~limited).sum()
     fi = [F, -F]
     if a.force == "consistent":  # -dE/du_p on the particles, scattered with S
         fi = [sign * (W[j].T @ (mp * (W[j] @ (F / safe[j])))) for j, sign in ((0, 1.0), (1, -1.0))]
     vn, un, sn, moves, new_velocity = [], [], [], [], []
+    momenta = [W[j].T @ (mp * v[j]) for j in range(2)]
+    if limited.any():  # pass A: where limited, both fields' momenta to the centre of mass
+        vc = (momenta[0] + momenta[1]) / (safe[0] + safe[1])
+        momenta = [np.where(limited, m[j] * vc, momenta[j]) for j in range(2)]
+    old_velocity = []
     for j in range(2):
         ok = m[j] > 0
-        p = W[j].T @ (mp * v[j])
+        p = momenta[j]
         f = -G[j].T @ (Vp * s[j])
-        v_old = np.where(ok, p / safe[j], 0.0)
+        # The FLIP increment starts after pass A (ALGORITHM 2: pass A's
+        # change moves the grid, not the particles' velocities).
+        old_velocity.append(np.where(ok, p / safe[j], 0.0))
         v_new = np.where(ok, (p + dt * (f + fi[j])) / safe[j], 0.0)
         new_velocity.append(v_new)
-        v_particle = v[j] + W[j] @ (v_new - v_old)  # FLIP
+    if limited.any():  # stick where limited: both fields to the centre of mass (pass B)
+        mom = sum(m[j] * new_velocity[j] for j in range(2))
+        vc = mom / (safe[0] + safe[1])
+        new_velocity = [np.where(limited, vc, new_velocity[j]) for j in range(2)]
+    v_particles = [v[j] + W[j] @ (new_velocity[j] - old_velocity[j]) for j in range(2)]  # FLIP
+    # MUSL's re-extrapolated velocities, stuck again where limited (pass B, strain)
+    v_remaps = [np.where(m[j] > 0, (W[j].T @ (mp * v_particles[j])) / safe[j], 0.0) for j in range(2)]
+    if limited.any():
+        vc = sum(m[j] * v_remaps[j] for j in range(2)) / (safe[0] + safe[1])
+        v_remaps = [np.where(limited, vc, v_remaps[j]) for j in range(2)]
+    for j in range(2):
+        v_new, v_particle, v_remap = new_velocity[j], v_particles[j], v_remaps[j]
         move = dt * (W[j] @ v_new)
         if a.scheme == "usl":
             rate = G[j] @ v_new
             u_new = u[j] + move
         else:  # MUSL: the strain from the re-extrapolated velocity
-            v_remap = np.where(ok, (W[j].T @ (mp * v_particle)) / safe[j], 0.0)
             rate = G[j] @ v_remap
             remap_move = dt * (W[j] @ v_remap)
             if a.displacement == "anchored":  # the step's start plus its remapped move
@@ -151,6 +187,9 @@ def main():
     p.add_argument("--delta", choices=["extrapolated", "nodal"], default="extrapolated")
     p.add_argument("--force", choices=["nodal", "consistent"], default="nodal")
     p.add_argument("--displacement", choices=["grid", "remap", "anchored"], default="grid")
+    p.add_argument("--force-limit", action="store_true", help="the paper's clip (ALGORITHM 4.4)")
+    p.add_argument("--limit-gate", action="store_true",
+                   help="with --force-limit: clip only where D A dt^2 > 2 m_red (omega dt > sqrt 2)")
     a = p.parse_args()
     e = run(a)
     print(f"Dn {a.Dn:g} ppc {a.ppc} cfl {a.cfl:g} {a.scheme} delta={a.delta} force={a.force} "

@@ -23,7 +23,8 @@ from interface_energy_1d import Bars, step  # noqa: E402  (the same step, weight
 
 def step_matrix(Dn, ppc, cells, h, E, cfl, scheme, displacement):
     a = SimpleNamespace(Dn=Dn, ppc=ppc, cells=cells, h=h, E=E, cfl=cfl, v0=0.0, scheme=scheme,
-                        delta="extrapolated", force="nodal", displacement=displacement)
+                        delta="extrapolated", force="nodal", displacement=displacement,
+                        force_limit=False)
     bars = Bars(a)
     W, G = zip(*(bars.weights(X) for X in bars.X))
     n = [len(X) for X in bars.X]

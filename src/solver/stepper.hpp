@@ -25,6 +25,7 @@
 #include "kernels/p2g_multimaterial.hpp"
 #include "kernels/reduce.hpp"
 #include "kernels/separation_extrapolation.hpp"
+#include "kernels/separation_shift.hpp"
 #include "kernels/shape.hpp"
 #include "kernels/support_gradients.hpp"
 #include "kernels/supports.hpp"
@@ -190,6 +191,13 @@ class Stepper final : public Simulation {
   // first P2G, and the G2P's increment shifted by v*.
   void xpic_filter();
   void apply_xpic_shift();
+  // fn(b, e) on each of this thread's uncolored particle ranges, on the
+  // team; fn returns the first particle it could not handle, or e. Returns
+  // the smallest such particle, or SIZE_MAX.
+  template <class RangeFn>
+  std::size_t first_stop_in_particle_ranges(RangeFn&& fn);
+  bool shifts_separation() const;
+  void advance_separation_shift_stage();
   Supports<Real> supports(bool with_dvel);
   void add_rigid_work();
   void collect_support_reactions();
