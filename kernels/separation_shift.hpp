@@ -28,10 +28,10 @@ namespace mmpm {
 
 // Particles [begin, end): shift += dt S v* - (x_next - x), with S at the
 // step's starting positions x and v* the nodal velocities `vstar` of each
-// particle's field, in the interpolation's own pass (no scratch: the pass
-// is memory-bound); a rigid field's particles (rigid[field] != 0) keep
-// their shift (their x - x0 is the prescribed motion itself). Returns the
-// first particle whose stencil leaves the grid (its shift untouched), or end.
+// particle's field, in the interpolation's own pass (no scratch arrays);
+// a rigid field's particles (rigid[field] != 0) keep their shift (their
+// x - x0 is the prescribed motion itself). Returns the first particle
+// whose stencil leaves the grid (its shift untouched), or end.
 template <int D, class Shape, class Real>
 std::size_t advance_separation_shift(const ParticleView<D, Real>& P, const GridView<D, Real>& G,
                                      const std::array<const Real*, D>& vstar,
