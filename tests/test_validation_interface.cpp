@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "tests/analytic.hpp"
+#include "tests/test_util.hpp"
 #include "tests/validation_util.hpp"
 
 namespace mmpm {
@@ -1855,12 +1856,9 @@ struct WaveHistory {
 // Mean displacement component c of the particles seeded within 0.1 mm of x0:
 // the two particle columns either side of x0 at 2 particles per cell (h >= 0.125).
 double column_mean_displacement(const Simulation& sim, double x0, int c) {
-  const Column x = field(sim, "position"), u = field(sim, "displacement");
-  double sum = 0, count = 0;
-  for (std::size_t p = 0; p < sim.particle_count(); ++p)
-    if (std::abs(x.at(p, 0) - u.at(p, 0) - x0) < 0.1) sum += u.at(p, c), count += 1;
-  EXPECT_GT(count, 0.0) << "no particle column at x = " << x0;
-  return sum / count;
+  const double mean = testing::seeded_mean_displacement(sim, 0, x0, 0.1, c);
+  EXPECT_TRUE(std::isfinite(mean)) << "no particle column at x = " << x0;
+  return mean;
 }
 
 // A pressure wave crosses the normal spring Dn (Dt perfect); a shear wave
@@ -1900,8 +1898,7 @@ WaveHistory run_wave(Wave kind, double h, double D, double x_b, double t_end,
                      : "grid.cell=[" + num(h) + "," + num(h) + "," + num(h) + "]",
       "grid.cells=[" + cells + (dimension == 2 ? "" : "," + std::to_string(std::lround(3.0 / h))) +
           "]"};
-  std::ifstream file(input_path("wave_interface.toml"));
-  std::string text{std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>()};
+  std::string text = mmpm_test::read_text(input_path("wave_interface.toml"));
   if (dimension == 3) text = wave_scene_in_3d(text);
   if (kind == Wave::pressure) {
     ov.push_back("interaction[0].Dn=" + stiffness_value(D));

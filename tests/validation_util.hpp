@@ -68,14 +68,21 @@ inline Column field(const Simulation& sim, const std::string& name) {
   return {std::move(f.values), f.components};
 }
 
-// The mean of displacement component c over the particles seeded at height
-// y0 (2D: y of position − displacement), as a row of a box of particles.
-inline double row_mean_displacement(const Simulation& sim, double y0, int c) {
+// The mean of displacement component c over the particles seeded within
+// `within` of `seed` along `axis` (the seed: position − displacement), as a
+// row or a column of a box of particles; NaN when there is none.
+inline double seeded_mean_displacement(const Simulation& sim, int axis, double seed, double within,
+                                       int c) {
   const Column x = field(sim, "position"), u = field(sim, "displacement");
   double sum = 0, count = 0;
   for (std::size_t p = 0; p < sim.particle_count(); ++p)
-    if (std::abs(x.at(p, 1) - u.at(p, 1) - y0) < 1e-6) sum += u.at(p, c), count += 1;
+    if (std::abs(x.at(p, axis) - u.at(p, axis) - seed) < within) sum += u.at(p, c), count += 1;
   return sum / count;
+}
+
+// The row of particles seeded at height y0 (2D: y of position − displacement).
+inline double row_mean_displacement(const Simulation& sim, double y0, int c) {
+  return seeded_mean_displacement(sim, 1, y0, 1e-6, c);
 }
 
 // A model on mirror planes against the whole body it mirrors: the largest
