@@ -49,6 +49,7 @@ namespace mmpm::bench {
 // Registration entry points, called in this order by bench_main.cpp.
 void register_p2g();
 void register_g2p();
+void register_separation_shift();
 void register_grid();
 void register_multimaterial();
 void register_sort();

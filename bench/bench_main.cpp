@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   argv = args.data();
   mmpm::bench::register_p2g();
   mmpm::bench::register_g2p();
+  mmpm::bench::register_separation_shift();
   mmpm::bench::register_grid();
   mmpm::bench::register_multimaterial();
   mmpm::bench::register_sort();

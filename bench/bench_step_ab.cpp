@@ -73,8 +73,10 @@ void register_step_ab() {
   // prefetch_grid: the 2D transfers without the grid lines requested a line
   // ahead; prefetch_particles: the transfers without the particle columns
   // requested a batch ahead; xpic_2: XPIC(2) particle velocities (what one
-  // term of the series costs, kernels/xpic.hpp); same_settings: B as A
-  // (the control).
+  // term of the series costs, kernels/xpic.hpp); force_limit_false: the
+  // two-layer interface (Dt = 5, where the limit never fires) without the
+  // limit, so without MUSL's separation shift (Stepper::shifts_separation):
+  // what the shift costs a step; same_settings: B as A (the control).
   const std::pair<const char*, const char*> settings[] = {
       {"fuse_step_tail_false", "simulation.fuse_step_tail=false"},
       {"particle_order_tile", "simulation.particle_order=\"tile\""},
@@ -84,6 +86,7 @@ void register_step_ab() {
       {"prefetch_grid_false", "simulation.prefetch_grid=false"},
       {"prefetch_particles_false", "simulation.prefetch_particles=false"},
       {"xpic_2", "simulation.xpic_order=2"},
+      {"force_limit_false", "interaction[0].force_limit=false"},
       {"same_settings", ""}};
   for (const auto& [label, override_b] : settings)
     for (const char* scene : {"2d_linear_1mat", "2d_gimp_interface", "2d_gimp_inclusions",
@@ -103,6 +106,7 @@ void register_step_ab() {
           if (prefetch && (sc == "3d_gimp_1mat" || sc == "2d_linear_room")) continue;
           if (lb == "tile_16" && sc != "2d_linear_1e6") continue;
           if (lb == "xpic_2" && sc == "2d_gimp_inclusions") continue;
+          if (lb == "force_limit_false" && sc != "2d_gimp_interface") continue;
           if (lb == "tile_32" && (sc == "3d_gimp_1mat" || sc == "2d_linear_room")) continue;
         }
         const std::string name = std::string("step_ab/scene:") + scene + "/b:" + label +

@@ -345,6 +345,11 @@ def kernel_section(R):
               "G2P one particle per vector: the double windowed gather of the shapes binned by "
               "the nearest node (uGIMP, quadratic B-spline; 2D and 3D) without pairs of "
               "particles per 512-bit vector, the solver's baseline in the same run. "
+           "MUSL gradient pass + separation shift: the step's last G2P (velocity gradient, "
+           "position commit) advancing an interface scene's separation shift in the same pass "
+           "(kernels/separation_shift.hpp), against the gradient pass followed by the shift's "
+           "own pass (the reference column) and the gradient pass alone (no shift); two fields "
+           "split at mid-block. "
            "Constitutive: isotropic small-strain "
            "update (plane strain in 2D). Same particle blocks as P2G.", ""]
     header = ["kernel", "dim", "shape", "real", "1 thread", "2 threads", "speed-up",
@@ -386,6 +391,22 @@ def kernel_section(R):
                 if a1 is not None or a2 is not None:
                     rows.append(["MUSL fused, momenta after each batch", dim + "D", shape, real, fmt(a1),
                                  fmt(a2), ratio(a1, a2), "–", "–", ratio(a1, v1) + " (vs solver)"])
+            # MUSL's gradient pass with the separation shift inside it (the
+            # solver's), against the pass followed by the shift's own pass,
+            # and against the gradient pass alone (no interface spring).
+            for shape in SHAPES:
+                want = dict(dim=dim, shape=shape, real=real)
+                f1, f2, s1, n1, n2 = (
+                    R.value("g2p_gradient_shift", ns, kernel=k, threads=t, **want)
+                    for k, t in (("fused", 1), ("fused", 2), ("separate", 1), ("none", 1),
+                                 ("none", 2)))
+                if f1 is None and f2 is None:
+                    continue
+                rows.append(["MUSL gradient pass + separation shift", dim + "D", shape, real,
+                             fmt(f1), fmt(f2), ratio(f1, f2), "–", fmt(s1) + " (own pass)",
+                             ratio(s1, f1)])
+                rows.append(["MUSL gradient pass, no shift", dim + "D", shape, real, fmt(n1),
+                             fmt(n2), ratio(n1, n2), "–", "–", ratio(f1, n1) + " (with shift)"])
             v1 = R.value("constitutive", ns, dim=dim, law="isotropic", real=real, threads=1)
             v2 = R.value("constitutive", ns, dim=dim, law="isotropic", real=real, threads=2)
             gb = R.value("constitutive", "particle_GBps", dim=dim, law="isotropic", real=real, threads=2)
@@ -541,6 +562,12 @@ PAIRED_SETTINGS = [
      "A with the defaults (pure FLIP) and B with one term of the XPIC series (an interpolation "
      "to the particles and a colored scatter of momenta per step, kernels/xpic.hpp)",
      "XPIC(2) costs more", "g2p"),
+    ("force_limit_false", "MUSL's separation shift, paired blocks "
+     "(B: interaction[0].force_limit = false)",
+     "A with the defaults (the interface spring Dt = 5 under the force limit, so MUSL's "
+     "gradient pass also advances the separation shift, kernels/separation_shift.hpp) and B "
+     "without the limit (which never fires at Dt = 5) and so without the shift",
+     "the shift costs time", "g2p"),
     ("same_settings", "Control: two Simulations with the same settings, paired blocks",
      "A and B both with the defaults (B made after A): what the harness itself puts between two "
      "equal runs, the scale against which the rows above are read", "A is slower", "g2p"),

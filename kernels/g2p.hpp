@@ -115,7 +115,9 @@ struct G2PGather {
   }
 
   // vn, dv: velocity and its change over the step; L row-major dv_a/dx_b.
-  template <bool Motion, bool Gradient>
+  // Velocity: vn without dv (the separation shift of the gradient pass;
+  // the windowed sums form S v with the gradient's anyway).
+  template <bool Motion, bool Gradient, bool Velocity = Motion>
   [[gnu::always_inline]] void gather(const Weights& w, const GridVelocity<D, Real>& V,
                                      std::size_t field_offset, Held& held, Real* vn, Real* dv,
                                      Real* L) const {
@@ -126,10 +128,8 @@ struct G2PGather {
         const Real s = w.w[k];
         for (int d = 0; d < D; ++d) {
           const Real vi = V.vel[d][i];
-          if constexpr (Motion) {
-            vn[d] += s * vi;
-            dv[d] += s * V.dvel[d][i];
-          }
+          if constexpr (Motion || Velocity) vn[d] += s * vi;
+          if constexpr (Motion) dv[d] += s * V.dvel[d][i];
           if constexpr (Gradient)
             for (int e = 0; e < D; ++e) L[d * D + e] += vi * w.g[k][e];
         }
@@ -163,7 +163,8 @@ struct G2PGather {
                               X * A[1], X * Q[1], GX * A[1], X * B[1]};
         const Lanes<Real, 8> s = lanes_sum8<Real, Ln>(parts);
         for (int d = 0; d < D; ++d) {
-          if constexpr (Motion) vn[d] = s[4 * d], dv[d] = s[4 * d + 1];
+          if constexpr (Motion || Velocity) vn[d] = s[4 * d];
+          if constexpr (Motion) dv[d] = s[4 * d + 1];
           if constexpr (Gradient) L[d * D + 0] = s[4 * d + 2], L[d * D + 1] = s[4 * d + 3];
         }
         return;
@@ -174,17 +175,16 @@ struct G2PGather {
           const Lanes<Real, 4> s1 =
               lanes_sum4(lanes_fold4<Real, Ln>(X * A[d]), lanes_fold4<Real, Ln>(X * Q[d]),
                          lanes_fold4<Real, Ln>(GX * A[d]), lanes_fold4<Real, Ln>(X * B[d]));
-          if constexpr (Motion) vn[d] = s1[0], dv[d] = s1[1];
+          if constexpr (Motion || Velocity) vn[d] = s1[0];
+          if constexpr (Motion) dv[d] = s1[1];
           if constexpr (Gradient) {
             L[d * D + 0] = s1[2];
             L[d * D + 1] = s1[3];
             if constexpr (D == 3) L[d * D + 2] = lanes_sum<Real, Ln>(X * C[d]);
           }
         } else {
-          if constexpr (Motion) {
-            vn[d] = lanes_sum<Real, Ln>(X * A[d]);
-            dv[d] = lanes_sum<Real, Ln>(X * Q[d]);
-          }
+          if constexpr (Motion || Velocity) vn[d] = lanes_sum<Real, Ln>(X * A[d]);
+          if constexpr (Motion) dv[d] = lanes_sum<Real, Ln>(X * Q[d]);
           if constexpr (Gradient) {
             L[d * D + 0] = lanes_sum<Real, Ln>(GX * A[d]);
             L[d * D + 1] = lanes_sum<Real, Ln>(X * B[d]);
@@ -206,7 +206,7 @@ struct G2PGather {
   // the 3D G2P kernels on one thread (docs/performance.md "Two particles
   // per vector in the 3D gathers"), and 2D's since its windows have 3 rows
   // ("The same in 2D double").
-  template <bool Motion, bool Gradient>
+  template <bool Motion, bool Gradient, bool Velocity = Motion>
   [[gnu::always_inline]] void gather_pair(const Weights& wa, const Weights& wb,
                                           const GridVelocity<D, Real>& V, std::size_t b0,
                                           Held& held, Real (*vn)[D], Real (*dv)[D],
@@ -267,7 +267,8 @@ struct G2PGather {
       const V2 s1 = __builtin_shufflevector(aq, ce, 0, 1, 8, 9, 4, 5, 12, 13) +
                     __builtin_shufflevector(aq, ce, 2, 3, 10, 11, 6, 7, 14, 15);
       for (int k = 0; k < 2; ++k) {
-        if constexpr (Motion) vn[k][d] = s1[4 * k], dv[k][d] = s1[4 * k + 1];
+        if constexpr (Motion || Velocity) vn[k][d] = s1[4 * k];
+        if constexpr (Motion) dv[k][d] = s1[4 * k + 1];
         if constexpr (Gradient) {
           L[k][d * D + 0] = s1[4 * k + 2];
           L[k][d * D + 1] = s1[4 * k + 3];
@@ -378,6 +379,9 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
   // does not gather stay 0, as gather()'s zeroed locals.
   constexpr bool kPairs = Gather::kPairs;
   constexpr bool kMotion = (What & kUpdateMotion) != 0, kGradient = (What & kVelocityGradient) != 0;
+  constexpr bool kVelocity = kMotion || (What & kSeparationShift) != 0;
+  static_assert((What & kSeparationShift) == 0 || (What & kCommitPosition) != 0,
+                "the shift reads x_next before the commit");
   struct Gathered {
     Real vn[kWeightBatch][D] = {}, dv[kWeightBatch][D] = {}, L[kWeightBatch][D * D] = {};
     std::size_t first = 0;
@@ -402,12 +406,12 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
         const std::size_t b = w[i].base + field_offset<MultiField>(P, G, first + i);
         if (i + 1 < n && ok[i + 1] &&
             w[i + 1].base + field_offset<MultiField>(P, G, first + i + 1) == b) {
-          st.template gather_pair<kMotion, kGradient>(w[i], w[i + 1], V, b, held, gathered.vn + i,
-                                                      gathered.dv + i, gathered.L + i);
+          st.template gather_pair<kMotion, kGradient, kVelocity>(
+              w[i], w[i + 1], V, b, held, gathered.vn + i, gathered.dv + i, gathered.L + i);
           i += 2;
         } else {
-          st.template gather<kMotion, kGradient>(w[i], V, b - w[i].base, held, gathered.vn[i],
-                                                 gathered.dv[i], gathered.L[i]);
+          st.template gather<kMotion, kGradient, kVelocity>(
+              w[i], V, b - w[i].base, held, gathered.vn[i], gathered.dv[i], gathered.L[i]);
           i += 1;
         }
       }
@@ -431,7 +435,7 @@ G2PRangeResult g2p_range_impl(const ParticleView<D, Real>& particles, const Grid
           P, q, dt, flip, pic, p, gathered.vn[i], gathered.dv[i], gathered.L[i], r, stress);
     } else {
       Real vn[D] = {}, dv[D] = {}, L[D * D] = {};
-      st.template gather<kMotion, kGradient>(w, V, fo, held, vn, dv, L);
+      st.template gather<kMotion, kGradient, kVelocity>(w, V, fo, held, vn, dv, L);
       detail::update_particle<D, Real, What, Traction, Gravity>(P, q, dt, flip, pic, p, vn, dv, L,
                                                                 r, stress);
     }

@@ -121,6 +121,12 @@ template <class Real, unsigned What, bool Traction, bool Gravity, int K, class V
       lanes_store(P.L[2 * d] + p, lanes_pick<K>(sums[d], [](int c) { return 4 * c + 2; }));
       lanes_store(P.L[2 * d + 1] + p, lanes_pick<K>(sums[d], [](int c) { return 4 * c + 3; }));
     }
+  if constexpr ((What & kSeparationShift) != 0)  // detail::advance_shift, K lanes at once
+    for (int d = 0; d < 2; ++d) {
+      const S vn = lanes_pick<K>(sums[d], [](int c) { return 4 * c; });
+      const S moved = lanes_load<S>(P.x_next[d] + p) - lanes_load<S>(P.x[d] + p);
+      lanes_store(P.sep_shift[d] + p, lanes_load<S>(P.sep_shift[d] + p) + (dt * vn - moved));
+    }
   if constexpr ((What & kCommitPosition) != 0)
     for (int d = 0; d < 2; ++d) lanes_store(P.x[d] + p, lanes_load<S>(P.x_next[d] + p));
 }
@@ -202,7 +208,9 @@ G2PRangeResult g2p_range_packed(const ParticleView<2, Real>& particles,
         }
         const int count = int(std::min<std::size_t>(std::size_t(K), j - k));
         bool whole = count == K && (What & kStressUpdate) == 0;
-        if constexpr ((What & kUpdateMotion) != 0 && MultiField)
+        // Groups with a rigid particle go particle by particle (its motion
+        // is prescribed, its shift kept).
+        if constexpr ((What & (kUpdateMotion | kSeparationShift)) != 0 && MultiField)
           if (whole && q.rigid)
             for (int c = 0; c < K; ++c)
               whole = whole && !q.rigid[P.field[first + k + std::size_t(c)]];

@@ -28,6 +28,11 @@ enum G2PWhat : unsigned {
   // With kVelocityGradient: the constitutive update of each particle right
   // after its L (the StressFn argument), instead of a pass of its own.
   kStressUpdate = 16u,
+  // With kCommitPosition (MUSL's gradient pass, which gathers from v*):
+  // the separation shift of kernels/separation_shift.hpp takes
+  // dt S v* - (x_next - x) right before the commit, from the same weights
+  // and the same gathered sum S v* the gradient's sums come with.
+  kSeparationShift = 32u,
 };
 
 // The particle columns a G2P pass of `what` streams (kernels/particle_prefetch.hpp).
@@ -36,7 +41,8 @@ constexpr unsigned g2p_streams(unsigned what) {
          ((what & kScatterMomentum) ? unsigned(kStreamMomentum) : 0u) |
          ((what & kVelocityGradient) ? unsigned(kStreamGradient) : 0u) |
          ((what & kCommitPosition) ? unsigned(kStreamCommit) : 0u) |
-         ((what & kStressUpdate) ? unsigned(kStreamConstitutive) : 0u);
+         ((what & kStressUpdate) ? unsigned(kStreamConstitutive) : 0u) |
+         ((what & kSeparationShift) ? unsigned(kStreamShift) : 0u);
 }
 
 struct G2PParams {
@@ -117,10 +123,21 @@ template <int D, class Real, bool Traction, bool Gravity>
   return work * q.dt;
 }
 
+// kSeparationShift: particle p's shift += dt v* - (x_next - x), with vn
+// the gathered S v*; a rigid field's particles keep theirs (their x - x0
+// is the prescribed motion itself). The formula of
+// advance_separation_shift (kernels/separation_shift.hpp).
+template <int D, class Real>
+[[gnu::always_inline]] inline void advance_shift(const ParticleView<D, Real>& P, const G2PParams& q,
+                                                 Real dt, std::size_t p, const Real* vn) {
+  if (q.rigid && P.field && q.rigid[P.field[p]]) return;
+  for (int d = 0; d < D; ++d) P.sep_shift[d][p] += dt * vn[d] - (P.x_next[d][p] - P.x[d][p]);
+}
+
 // Particle p's update from vn (grid velocity), dv (its change over the
 // step) and L (row-major dv_a/dx_b) gathered for it: FLIP/PIC velocity,
 // position (or x_next), the work of external forces, L, the fused stress
-// update and the position commit, as What asks.
+// update, the separation shift and the position commit, as What asks.
 template <int D, class Real, unsigned What, bool Traction, bool Gravity, class StressFn>
 [[gnu::always_inline]] inline void update_particle(const ParticleView<D, Real>& P,
                                                    const G2PParams& q, Real dt, Real flip, Real pic,
@@ -143,6 +160,7 @@ template <int D, class Real, unsigned What, bool Traction, bool Gravity, class S
     for (int c = 0; c < D * D; ++c) P.L[c][p] = L[c];
   if constexpr ((What & kStressUpdate) != 0)
     if (!stress(P, p) && r.unsound == SIZE_MAX) r.unsound = p;
+  if constexpr ((What & kSeparationShift) != 0) advance_shift(P, q, dt, p, vn);
   if constexpr ((What & kCommitPosition) != 0)
     for (int d = 0; d < D; ++d) P.x[d][p] = P.x_next[d][p];
 }

@@ -39,6 +39,7 @@ enum ParticleStreams : unsigned {
   kStreamCommit = 1u << 4,        // x <- x_next: x_next (the tile-change test reads the
                                   // key after the range, as one stream)
   kStreamConstitutive = 1u << 5,  // the stress update: sigma, V, H, the material byte
+  kStreamShift = 1u << 6,         // MUSL's separation shift: sep_shift (x_next with kStreamCommit)
 };
 inline constexpr unsigned kStreamTransfer =
     kStreamScatter | kStreamMotion | kStreamGradient | kStreamCommit;
@@ -88,6 +89,8 @@ class ParticleLinesAhead {
       for (int d = 0; d < D; ++d) add(P.x_next[d], true);
     if (streams & kStreamCommit)
       for (int d = 0; d < D; ++d) add(P.x_next[d], false);
+    if (streams & kStreamShift)
+      for (int d = 0; d < D; ++d) add(P.sep_shift[d], true);
   }
 
   bool on() const { return reads_ + writes_ > 0; }

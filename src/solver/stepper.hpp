@@ -25,7 +25,6 @@
 #include "kernels/p2g_multimaterial.hpp"
 #include "kernels/reduce.hpp"
 #include "kernels/separation_extrapolation.hpp"
-#include "kernels/separation_shift.hpp"
 #include "kernels/shape.hpp"
 #include "kernels/support_gradients.hpp"
 #include "kernels/supports.hpp"
@@ -197,7 +196,6 @@ class Stepper final : public Simulation {
   template <class RangeFn>
   std::size_t first_stop_in_particle_ranges(RangeFn&& fn);
   bool shifts_separation() const;
-  void advance_separation_shift_stage();
   Supports<Real> supports(bool with_dvel);
   void add_rigid_work();
   void collect_support_reactions();

@@ -620,6 +620,9 @@ template <int D, class Shape, class Real>
 ParticleLinesAhead Stepper<D, Shape, Real>::particles_ahead(unsigned streams,
                                                             bool L_in_columns) const {
   if (D == 3 || !scene_.simulation.prefetch_particles) return {};
+  // The commit pass also advances the separation shift, where there is one
+  // (g2p_range_of).
+  if ((streams & kStreamCommit) && P_.sep_shift[0]) streams |= kStreamShift;
   ParticleLinesAhead ahead(P_, streams, L_in_columns);
   if (P_.n * ahead.bytes_per_particle() < prefetch_min_particle_bytes_) return {};
   return ahead;
@@ -797,13 +800,21 @@ G2PRangeResult Stepper<D, Shape, Real>::g2p_range_of(const G2PParams& q, std::si
                                                      std::size_t e,
                                                      const ParticleView<D, Real>& P) const {
   const KeyFn key_of = key_fn();
-  auto run = [&]<bool MF, bool TR, bool GR>() {
-    if constexpr ((What & kStressUpdate) != 0)
-      return g2p_range<D, Shape, Real, What, MF, TR, GR>(
+  auto run = [&]<bool MF, bool TR, bool GR, unsigned W = What>() {
+    if constexpr ((W & kStressUpdate) != 0)
+      return g2p_range<D, Shape, Real, W, MF, TR, GR>(
           P, G_, GV_, q, key_of, b, e, IsotropicStressUpdate<D, Real>{stress_table_.data()});
     else
-      return g2p_range<D, Shape, Real, What, MF, TR, GR>(P, G_, GV_, q, key_of, b, e);
+      return g2p_range<D, Shape, Real, W, MF, TR, GR>(P, G_, GV_, q, key_of, b, e);
   };
+  // MUSL's gradient pass advances the separation shift where the scene has
+  // one (shifts_separation; only multimaterial scenes have interfaces).
+  if constexpr ((What & kCommitPosition) != 0)
+    if (plan_.multimaterial && P.sep_shift[0]) {
+      constexpr unsigned WS = What | kSeparationShift;
+      return has_gravity_ ? run.template operator()<true, false, true, WS>()
+                          : run.template operator()<true, false, false, WS>();
+    }
   // The tractions' work is the face loads' (add_face_traction_work).
   if (plan_.multimaterial)
     return has_gravity_ ? run.template operator()<true, false, true>()
@@ -1369,22 +1380,6 @@ bool Stepper<D, Shape, Real>::shifts_separation() const {
   return springs && all_limited;
 }
 
-// MUSL, once v* is on the grid and before the positions are committed:
-// each particle's shift takes dt S v* - (x_next - x), on the team in the
-// uncolored loops' particle ranges (each particle writes its own entries).
-template <int D, class Shape, class Real>
-void Stepper<D, Shape, Real>::advance_separation_shift_stage() {
-  const std::size_t n = P_.n;
-  std::array<const Real*, D> vstar;
-  for (int d = 0; d < D; ++d) vstar[std::size_t(d)] = GV_.vel[d];
-  const unsigned char* rigid = plan_.rigid.empty() ? nullptr : plan_.rigid.data();
-  if (const std::size_t bad = first_stop_in_particle_ranges([&](std::size_t b, std::size_t e) {
-        return advance_separation_shift<D, Shape, Real>(P_, G_, vstar, rigid, Real(dt_), b, e);
-      });
-      bad < n)
-    fail_particle("separation shift", bad, "its shape-function stencil left the grid");
-}
-
 // Right before the step's G2P (kernels/xpic.hpp): the FLIP increment
 // v_L - v takes v* more, and the deformable particles start from 0, so the
 // G2P gives them S (v* + v_L - v) (with flip < 1, blended with PIC's
@@ -1597,14 +1592,11 @@ void Stepper<D, Shape, Real>::step() {
     tic();
     finish_velocities(false);
     toc(kStageGrid);
-    if (P_.sep_shift[0]) {
-      tic();
-      advance_separation_shift_stage();
-      toc(kStageMultimaterial);
-    }
     // MUSL's strain comes from these re-extrapolated velocities; the first
     // update's can keep a node motion the particles do not take (a static
-    // bar's loaded node moved on, and that work drifted by 8 %).
+    // bar's loaded node moved on, and that work drifted by 8 %). The
+    // gradient pass below also advances the separation shift from them
+    // (kSeparationShift, where shifts_separation()).
     add_face_traction_work();
     if (step_tail_fusable())
       fused_step_tail();
