@@ -124,13 +124,15 @@ template <int D, class Real, bool Traction, bool Gravity>
 }
 
 // kSeparationShift: particle p's shift += dt v* - (x_next - x), with vn
-// the gathered S v*; a rigid field's particles keep theirs (their x - x0
-// is the prescribed motion itself). The formula of
-// advance_separation_shift (kernels/separation_shift.hpp).
+// the gathered S v*; a rigid field's particles (rigid[field] != 0) keep
+// theirs (their x - x0 is the prescribed motion itself). Also the update
+// of the shift's own pass (advance_separation_shift,
+// kernels/separation_shift.hpp).
 template <int D, class Real>
-[[gnu::always_inline]] inline void advance_shift(const ParticleView<D, Real>& P, const G2PParams& q,
-                                                 Real dt, std::size_t p, const Real* vn) {
-  if (q.rigid && P.field && q.rigid[P.field[p]]) return;
+[[gnu::always_inline]] inline void advance_shift(const ParticleView<D, Real>& P,
+                                                 const unsigned char* rigid, Real dt, std::size_t p,
+                                                 const Real* vn) {
+  if (rigid && P.field && rigid[P.field[p]]) return;
   for (int d = 0; d < D; ++d) P.sep_shift[d][p] += dt * vn[d] - (P.x_next[d][p] - P.x[d][p]);
 }
 
@@ -160,7 +162,7 @@ template <int D, class Real, unsigned What, bool Traction, bool Gravity, class S
     for (int c = 0; c < D * D; ++c) P.L[c][p] = L[c];
   if constexpr ((What & kStressUpdate) != 0)
     if (!stress(P, p) && r.unsound == SIZE_MAX) r.unsound = p;
-  if constexpr ((What & kSeparationShift) != 0) advance_shift(P, q, dt, p, vn);
+  if constexpr ((What & kSeparationShift) != 0) advance_shift(P, q.rigid, dt, p, vn);
   if constexpr ((What & kCommitPosition) != 0)
     for (int d = 0; d < D; ++d) P.x[d][p] = P.x_next[d][p];
 }

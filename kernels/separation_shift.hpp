@@ -27,6 +27,7 @@
 #include <array>
 #include <cstddef>
 
+#include "kernels/g2p_particle.hpp"
 #include "kernels/grid_view.hpp"
 #include "kernels/particle_view.hpp"
 #include "kernels/xpic.hpp"
@@ -46,10 +47,7 @@ std::size_t advance_separation_shift(const ParticleView<D, Real>& P, const GridV
                                      std::size_t end) {
   const ParticleView<D, Real> Pl = P;  // a local copy: the stores cannot alias it
   auto advance = [&](std::size_t p, const Real* sums) __attribute__((always_inline)) {
-    if (rigid && Pl.field && rigid[Pl.field[p]]) return;
-    for (int d = 0; d < D; ++d)
-      Pl.sep_shift[std::size_t(d)][p] +=
-          dt * sums[d] - (Pl.x_next[std::size_t(d)][p] - Pl.x[std::size_t(d)][p]);
+    detail::advance_shift(Pl, rigid, dt, p, sums);
   };
   return interpolate_to_particles_into<D, Shape, Real>(Pl, G, vstar, advance, begin, end);
 }

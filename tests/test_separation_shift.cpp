@@ -1,7 +1,10 @@
 // MUSL's separation shift advanced inside the gradient pass (G2PWhat
 // kSeparationShift, detail::advance_shift; the packed 2D linear gather's
 // update_group) against its own pass (kernels/separation_shift.hpp
-// advance_separation_shift, the reference):
+// advance_separation_shift, the reference: XPIC's interpolation of v*,
+// with the same one-particle update detail::advance_shift, so what is
+// compared is the gathered S v*, the packed lanes' update and the
+// dispatch):
 //  - the shift: c + dt S v* - (x_next - x) of the reference to round-off,
 //    |difference| <= 1e-12 (double) / 2e-5 (float) of the largest
 //    |dt S v*| (the two sum S v* in different orders);
