@@ -193,16 +193,22 @@ VecD<D, Real> force_difference(Real m_a, const VecD<D, Real>& f_a, Real m_b,
 
 // ---------------------------------------------------------------- exact integration
 // §4.5: along one direction the relative coordinate s = u_b − u_a obeys
-//   m_red s'' = −k s + Δf,  k = D A_i,  ω² = k / m_red,
-// solved exactly over Δt from s(0) = s0, s'(0) = w0 = Δp_a·d / m_red:
-//   s(Δt) = s* + (s0 − s*) cos θ + (w0/ω) sin θ,  s* = Δf/k,  θ = ωΔt.
-// The force applied is the one that, under the same midpoint rule as the force limit
-// (P-23 … P-25), lands the pair exactly on s(Δt):
-//   F = (2 m_red/Δt²)(s0 + w0 Δt − s(Δt)) + Δf
-//     = k s0 C(θ) + (2/Δt) Δp_a·d S(θ) + Δf (1 − C(θ)),
-//   C(θ) = 2(1 − cos θ)/θ² = (sin(θ/2)/(θ/2))²,  S(θ) = 1 − sin θ / θ.
-// C → 1, S → 0 as θ → 0 (the explicit force k s0); with s(Δt) = 0 it is f_lim. When
-// θ > 1.5 the direction is effectively perfect and becomes stick.
+//   m_red s'' = −k s + Δf,  k = D A_i,  ω² = k / m_red,  θ = ωΔt,  s* = Δf/k,
+// whose solution, sampled once a step, satisfies
+//   s_{n+1} − 2 cos θ s_n + s_{n−1} = 2 (1 − cos θ) s*.
+// MPM advances the pair as velocity first, then position with the new velocity
+// (w_{n+1} = w_n + Δt (Δf − F_n)/m_red, s_{n+1} = s_n + Δt w_{n+1}), i.e.
+//   s_{n+1} − 2 s_n + s_{n−1} = (Δt²/m_red)(Δf − F_n).
+// The two agree for every n when
+//   F = k C(θ) (s0 − s*) + Δf = k s0 C(θ) + Δf (1 − C(θ)),  C(θ) = 2(1 − cos θ)/θ²,
+// so the sampled positions are the exact oscillator's at any θ < π and the map keeps
+// the oscillator's energy (eigenvalues e^{±iθ}). The particles' velocity is the step's
+// mean, not the start-of-step velocity, so the relative velocity w0 plays no part: a
+// force that also landed (s0, w0) on s(Δt), as if w0 were that instant's velocity (the
+// earlier form, with (2/Δt) Δp_a·d (1 − sin θ/θ)), is a dashpot of k Δt/3 that took an
+// undamped vibration to 0.000 E0 in 1.5 ms (docs/interface_validation.md Finding 15).
+// C → 1 as θ → 0 (the explicit force k s0). When θ > 1.5 the direction is effectively
+// perfect and becomes stick (ALGORITHM §4.5). Derivation: docs/multimaterial.md §11.
 inline constexpr double kExactStickOmegaDt = 1.5;
 
 template <class Real>
@@ -221,24 +227,11 @@ inline Real oscillator_cos_term(Real theta) {
   const Real sinc = std::sin(half) / half;
   return sinc * sinc;
 }
-// S(θ) = 1 − sin θ/θ; a series below 0.5 avoids the cancellation (truncation < 1e-12 rel).
-template <class Real>
-inline Real oscillator_sin_term(Real theta) {
-  if (theta < Real(0.5)) {
-    const Real x2 = theta * theta;
-    return x2 / Real(6) *
-           (Real(1) -
-            x2 / Real(20) *
-                (Real(1) - x2 / Real(42) * (Real(1) - x2 / Real(72) * (Real(1) - x2 / Real(110)))));
-  }
-  return Real(1) - std::sin(theta) / theta;
-}
 }  // namespace mm_detail
 
 template <class Real>
 SpringStep<Real> exact_spring_force(Real stiffness, Real m_red, Real dt, Real separation,
-                                    Real momentum_change, Real force_difference = 0,
-                                    Real stick_dt = 0) {
+                                    Real force_difference = 0, Real stick_dt = 0) {
   SpringStep<Real> r;
   const Real omega = std::sqrt(stiffness / m_red);
   r.omega_dt = dt * omega;
@@ -248,9 +241,7 @@ SpringStep<Real> exact_spring_force(Real stiffness, Real m_red, Real dt, Real se
     return r;
   }
   const Real c = mm_detail::oscillator_cos_term(r.omega_dt);
-  const Real s = mm_detail::oscillator_sin_term(r.omega_dt);
-  r.force = stiffness * separation * c + Real(2) / dt * momentum_change * s +
-            force_difference * (Real(1) - c);
+  r.force = stiffness * separation * c + force_difference * (Real(1) - c);
   return r;
 }
 

@@ -339,8 +339,8 @@ DirectionOutcome<Real> interface_direction(const PairParams<Real>& pp, bool perf
     return o;
   }
   if (pp.integration == Integration::exact) {
-    const SpringStep<Real> s = exact_spring_force(stiffness * area, m_red, dt, separation,
-                                                  momentum_change, force_diff, limit_dt);
+    const SpringStep<Real> s =
+        exact_spring_force(stiffness * area, m_red, dt, separation, force_diff, limit_dt);
     if (s.stick) {
       o.stick = o.limited = true;
       return o;
