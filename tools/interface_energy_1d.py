@@ -24,6 +24,15 @@ Variants that test a cause:
                        MUSL only: that displacement reset every step to the
                        particle's x - x0 at the step's start plus the step's
                        re-extrapolated move
+  --scheme usf         the stress from the start-of-step velocities v^n (after
+                       pass A), then the forces
+  --displacement shift USF only: the displacement moves with dt S v^n, the
+                       motion USF's strain reads (MUSL's remap, for USF)
+  --displacement ahead USF only: x - x0 plus this step's dt S v^n on each
+                       particle before the opening is extrapolated (the
+                       stress of the step already holds it)
+  --displacement shift-ahead
+                       USF only: both
   --force-limit        the paper's clip (ALGORITHM 4.4): where the spring's
                        force exceeds f_lim the node sticks (both fields'
                        momenta to the centre of mass in pass A, outside the
@@ -86,6 +95,12 @@ def step(bars, W, G, v, u, s, a, hist=None, start_displacement=None):
     delta = np.where(both, mu[1] / safe[1] - mu[0] / safe[0], 0.0)
     if a.delta == "nodal":
         delta = np.where(both, hist, 0.0)
+    if a.scheme == "usf" and a.displacement in ("ahead", "shift-ahead"):
+        # USF's stress this step holds dt G v^n, so the opening takes the same
+        # step's move dt S v^n on each particle before it is extrapolated.
+        velocity = [np.where(m[j] > 0, (W[j].T @ (mp * v[j])) / safe[j], 0.0) for j in range(2)]
+        ahead = [W[j].T @ (mp * (u[j] + dt * (W[j] @ velocity[j]))) for j in range(2)]
+        delta = np.where(both, ahead[1] / safe[1] - ahead[0] / safe[0], 0.0)
     area = np.where(both, np.sqrt(2 * (vol[0] + vol[1]) * np.minimum(vol[0], vol[1])) / bars.h, 0.0)
     F = bars.Dn * area * delta  # on a, toward b (+x)
     limited = np.zeros(bars.nodes, dtype=bool)
@@ -111,6 +126,8 @@ def step(bars, W, G, v, u, s, a, hist=None, start_displacement=None):
     for j in range(2):
         ok = m[j] > 0
         p = momenta[j]
+        if a.scheme == "usf":  # the stress first, from the velocities after pass A
+            s[j] = s[j] + dt * bars.E * (G[j] @ np.where(ok, p / safe[j], 0.0))
         f = -G[j].T @ (Vp * s[j])
         # The FLIP increment starts after pass A (ALGORITHM 2: pass A's
         # change moves the grid, not the particles' velocities).
@@ -130,7 +147,11 @@ def step(bars, W, G, v, u, s, a, hist=None, start_displacement=None):
     for j in range(2):
         v_new, v_particle, v_remap = new_velocity[j], v_particles[j], v_remaps[j]
         move = dt * (W[j] @ v_new)
-        if a.scheme == "usl":
+        if a.scheme == "usf":  # its stress was updated before the forces
+            rate = np.zeros_like(s[j])
+            moved_as_strain = a.displacement in ("shift", "shift-ahead")
+            u_new = u[j] + (dt * (W[j] @ old_velocity[j]) if moved_as_strain else move)
+        elif a.scheme == "usl":
             rate = G[j] @ v_new
             u_new = u[j] + move
         else:  # MUSL: the strain from the re-extrapolated velocity
@@ -191,10 +212,10 @@ def main():
     p.add_argument("--drift", type=float, default=0.0,
                    help="a velocity added to both bars: the pair drifts through the grid "
                         "(its kinetic energy is left out of the ratio)")
-    p.add_argument("--scheme", choices=["musl", "usl"], default="musl")
+    p.add_argument("--scheme", choices=["musl", "usl", "usf"], default="musl")
     p.add_argument("--delta", choices=["extrapolated", "nodal"], default="extrapolated")
     p.add_argument("--force", choices=["nodal", "consistent"], default="nodal")
-    p.add_argument("--displacement", choices=["grid", "remap", "anchored"], default="grid")
+    p.add_argument("--displacement", choices=["grid", "remap", "anchored", "shift", "ahead", "shift-ahead"], default="grid")
     p.add_argument("--force-limit", action="store_true", help="the paper's clip (ALGORITHM 4.4)")
     p.add_argument("--limit-gate", action="store_true",
                    help="with --force-limit: clip only where D A dt^2 > 2 m_red (omega dt > sqrt 2)")
