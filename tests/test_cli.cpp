@@ -1105,6 +1105,40 @@ TEST(Cli, StiffInterfaceWithoutForceLimitWarns) {
   }
 }
 
+// An interface spring in an undamped scene under a scheme whose opening reads
+// another motion than its strain (docs/interface_validation.md Findings 14,
+// 15): USF, or MUSL without the force limit, warns once at the interaction's
+// line. inputs/wave_interface.toml has no damping. Quiet: the defaults (MUSL
+// under the limit), the exact integration, grid damping, USL, pure PIC and
+// perfect directions (no spring).
+TEST(Cli, UndampedInterfaceSpringThatGainsEnergyWarns) {
+  const std::string scene = source_dir() + "/inputs/wave_interface.toml";
+  const std::string usf = one_interaction_warning(
+      run_mmpm({"check", scene, "--set", "simulation.scheme=\"USF\""}), scene, "law");
+  EXPECT_TRUE(contains(usf, "under scheme \"USF\" with no grid damping")) << usf;
+  EXPECT_TRUE(contains(usf, "Finding 15")) << usf;
+  const std::string no_limit = one_interaction_warning(
+      run_mmpm({"check", scene, "--set", "interaction[0].force_limit=false"}), scene,
+      "force_limit");
+  EXPECT_TRUE(contains(no_limit, "force_limit = false with no grid damping")) << no_limit;
+  EXPECT_TRUE(contains(no_limit, "Finding 14")) << no_limit;
+  for (const std::vector<std::string>& sets :
+       {std::vector<std::string>{},
+        {"interaction[0].force_limit=false", "interaction[0].integration=\"exact\""},
+        {"interaction[0].force_limit=false", "grid.damping=10.0"},
+        {"simulation.scheme=\"USF\"", "grid.damping=10.0"},
+        {"interaction[0].force_limit=false", "simulation.scheme=\"USL\""},
+        {"simulation.scheme=\"USF\"", "simulation.flip=0.0"},
+        {"simulation.scheme=\"USF\"", "interaction[0].Dn=\"perfect\"",
+         "interaction[0].Dt=\"perfect\""}}) {
+    std::vector<std::string> args = {"check", scene};
+    for (const std::string& set : sets) args.insert(args.end(), {"--set", set});
+    const CmdResult quiet = run_mmpm(args);
+    ASSERT_EQ(quiet.exit_code, 0) << quiet.describe();
+    EXPECT_FALSE(contains(quiet.err, "no grid damping")) << quiet.describe();
+  }
+}
+
 // The kinetic-ratio stop waits until the scene no longer drives the bodies
 // (run_driver.cpp still_driven): inputs/gripped_bar.toml, whose rigid grip
 // pulls the bar until 0.1 ms. With kinetic_ratio = 0.1, a threshold the
