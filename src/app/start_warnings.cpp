@@ -284,10 +284,7 @@ std::vector<std::string> undamped_interface_growth_warnings(const Scene& scene) 
   if (scene.grid.damping > 0 || !(sim.flip > 0) || sim.scheme == Scheme::USL) return out;
   for (std::size_t k = 0; k < scene.interactions.size(); ++k) {
     const InteractionSpec& it = scene.interactions[k];
-    if (it.law != Law::interface || it.separation == Separation::position) continue;
-    const bool compression_spring =
-        it.traction_law == TractionLaw::bilinear && std::isfinite(it.Dn_compression);
-    if (!std::isfinite(it.Dn) && !std::isfinite(it.Dt) && !compression_spring) continue;
+    if (!has_displacement_spring(it)) continue;
     std::ostringstream m;
     if (sim.scheme == Scheme::USF) {
       m << interaction_warning(scene, k, "law")

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <limits>
 #include <optional>
 #include <string>
@@ -173,6 +174,16 @@ struct InteractionSpec {
   ContactArea area = ContactArea::paper;  // interface law only
   Where where;
 };
+
+// An interface with a spring that reads the particles' displacements: a
+// finite Dn or Dt (or the bilinear law's compression stiffness), and not the
+// position method, which reads x. A perfect interface has no spring.
+inline bool has_displacement_spring(const InteractionSpec& it) {
+  if (it.law != Law::interface || it.separation == Separation::position) return false;
+  const bool compression_spring =
+      it.traction_law == TractionLaw::bilinear && std::isfinite(it.Dn_compression);
+  return std::isfinite(it.Dn) || std::isfinite(it.Dt) || compression_spring;
+}
 
 enum class BoundaryWhere { face, plane, box };
 

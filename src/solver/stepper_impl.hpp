@@ -1374,10 +1374,7 @@ bool Stepper<D, Shape, Real>::shifts_separation() const {
   if (scene_.simulation.scheme != Scheme::MUSL || !(scene_.simulation.flip > 0)) return false;
   bool springs = false, all_limited = true;
   for (const auto& i : scene_.interactions) {
-    if (i.law != Law::interface || i.separation == Separation::position) continue;
-    const bool compression_spring =
-        i.traction_law == TractionLaw::bilinear && std::isfinite(i.Dn_compression);
-    if (!std::isfinite(i.Dn) && !std::isfinite(i.Dt) && !compression_spring) continue;
+    if (!has_displacement_spring(i)) continue;
     springs = true;
     all_limited = all_limited && (i.integration == Integration::exact || i.force_limit);
   }
