@@ -92,22 +92,22 @@ def step(bars, W, G, v, u, s, a, hist=None, start_displacement=None):
     both = (m[0] > 0) & (m[1] > 0)
     safe = [np.where(m[j] > 0, m[j], 1.0) for j in range(2)]
     mu = [W[j].T @ (mp * u[j]) for j in range(2)]
+    momenta = [W[j].T @ (mp * v[j]) for j in range(2)]  # P2G, before pass A
     delta = np.where(both, mu[1] / safe[1] - mu[0] / safe[0], 0.0)
     if a.delta == "nodal":
         delta = np.where(both, hist, 0.0)
     if a.scheme == "usf" and a.displacement in ("ahead", "shift-ahead"):
         # USF's stress this step holds dt G v^n, so the opening takes the same
         # step's move dt S v^n on each particle before it is extrapolated.
-        velocity = [np.where(m[j] > 0, (W[j].T @ (mp * v[j])) / safe[j], 0.0) for j in range(2)]
+        velocity = [np.where(m[j] > 0, momenta[j] / safe[j], 0.0) for j in range(2)]
         ahead = [W[j].T @ (mp * (u[j] + dt * (W[j] @ velocity[j]))) for j in range(2)]
         delta = np.where(both, ahead[1] / safe[1] - ahead[0] / safe[0], 0.0)
     area = np.where(both, np.sqrt(2 * (vol[0] + vol[1]) * np.minimum(vol[0], vol[1])) / bars.h, 0.0)
     F = bars.Dn * area * delta  # on a, toward b (+x)
     limited = np.zeros(bars.nodes, dtype=bool)
     if a.force_limit:  # ALGORITHM 4.4 (P-23..P-27), before the internal forces (pass A)
-        p0 = [W[j].T @ (mp * v[j]) for j in range(2)]
         m_red = np.where(both, m[0] * m[1] / (safe[0] + safe[1]), 0.0)
-        dp_a = m_red * np.where(both, p0[1] / safe[1] - p0[0] / safe[0], 0.0)
+        dp_a = m_red * np.where(both, momenta[1] / safe[1] - momenta[0] / safe[0], 0.0)
         f_lim = 2 * m_red * delta / dt ** 2 + 2 * dp_a / dt
         limited = both & (np.abs(F) > np.abs(f_lim))
         if a.limit_gate:  # only a spring stiffer than the one-step bound (omega dt > sqrt 2)
@@ -118,17 +118,17 @@ def step(bars, W, G, v, u, s, a, hist=None, start_displacement=None):
     if a.force == "consistent":  # -dE/du_p on the particles, scattered with S
         fi = [sign * (W[j].T @ (mp * (W[j] @ (F / safe[j])))) for j, sign in ((0, 1.0), (1, -1.0))]
     vn, un, sn, moves, new_velocity = [], [], [], [], []
-    momenta = [W[j].T @ (mp * v[j]) for j in range(2)]
     if limited.any():  # pass A: where limited, both fields' momenta to the centre of mass
         vc = (momenta[0] + momenta[1]) / (safe[0] + safe[1])
         momenta = [np.where(limited, m[j] * vc, momenta[j]) for j in range(2)]
     old_velocity = []
+    stress = list(s)  # USF updates it before the forces; the caller's s stays
     for j in range(2):
         ok = m[j] > 0
         p = momenta[j]
         if a.scheme == "usf":  # the stress first, from the velocities after pass A
-            s[j] = s[j] + dt * bars.E * (G[j] @ np.where(ok, p / safe[j], 0.0))
-        f = -G[j].T @ (Vp * s[j])
+            stress[j] = s[j] + dt * bars.E * (G[j] @ np.where(ok, p / safe[j], 0.0))
+        f = -G[j].T @ (Vp * stress[j])
         # The FLIP increment starts after pass A (ALGORITHM 2: pass A's
         # change moves the grid, not the particles' velocities).
         old_velocity.append(np.where(ok, p / safe[j], 0.0))
@@ -148,7 +148,7 @@ def step(bars, W, G, v, u, s, a, hist=None, start_displacement=None):
         v_new, v_particle, v_remap = new_velocity[j], v_particles[j], v_remaps[j]
         move = dt * (W[j] @ v_new)
         if a.scheme == "usf":  # its stress was updated before the forces
-            rate = np.zeros_like(s[j])
+            rate = np.zeros_like(stress[j])
             moved_as_strain = a.displacement in ("shift", "shift-ahead")
             u_new = u[j] + (dt * (W[j] @ old_velocity[j]) if moved_as_strain else move)
         elif a.scheme == "usl":
@@ -163,7 +163,7 @@ def step(bars, W, G, v, u, s, a, hist=None, start_displacement=None):
                 u_new = u[j] + (remap_move if a.displacement == "remap" else move)
         vn.append(v_particle)
         un.append(u_new)
-        sn.append(s[j] + dt * bars.E * rate)
+        sn.append(stress[j] + dt * bars.E * rate)
         moves.append(move)
     if hist is not None:
         hist = np.where(both, hist + dt * (new_velocity[1] - new_velocity[0]), 0.0)
@@ -215,7 +215,8 @@ def main():
     p.add_argument("--scheme", choices=["musl", "usl", "usf"], default="musl")
     p.add_argument("--delta", choices=["extrapolated", "nodal"], default="extrapolated")
     p.add_argument("--force", choices=["nodal", "consistent"], default="nodal")
-    p.add_argument("--displacement", choices=["grid", "remap", "anchored", "shift", "ahead", "shift-ahead"], default="grid")
+    p.add_argument("--displacement", default="grid",
+                   choices=["grid", "remap", "anchored", "shift", "ahead", "shift-ahead"])
     p.add_argument("--force-limit", action="store_true", help="the paper's clip (ALGORITHM 4.4)")
     p.add_argument("--limit-gate", action="store_true",
                    help="with --force-limit: clip only where D A dt^2 > 2 m_red (omega dt > sqrt 2)")
